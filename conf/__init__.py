@@ -1,0 +1,1 @@
+"""Hydra config root of pegame, installed as the package pegame.conf."""

@@ -1,0 +1,1 @@
+"""The paper's maps, installed as the package pegame.maps_data."""

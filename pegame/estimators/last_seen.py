@@ -1,0 +1,20 @@
+"""Baseline estimator: the evader is believed to be where it was last detected."""
+
+from __future__ import annotations
+
+from pegame.api import EMPTY_BELIEF, Belief, Estimator
+
+
+class LastSeen(Estimator):
+    """The last detected map position, held until the next detection."""
+
+    description = "Baseline: the evader's last detected map position."
+
+    def reset(self, pursuer, detection, visible) -> Belief:
+        self.belief = EMPTY_BELIEF
+        return self.update(0.0, pursuer, detection, visible)
+
+    def update(self, dt, pursuer, detection, visible) -> Belief:
+        if detection is not None:
+            self.belief = Belief(mean=detection.position)
+        return self.belief

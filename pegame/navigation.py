@@ -1,0 +1,609 @@
+"""Grid navigation: the role ROS move_base plays in the paper.
+
+In the paper every agent reaches its goal through move_base: a global planner on an
+inflated costmap and a local controller that drives a non-holonomic robot along the
+plan. This module provides the same three pieces for occupancy grids:
+
+* :func:`inflate` - the inflated obstacle mask (the costmap's lethal + inscribed zone);
+  the grid simulator uses ``inflate(grid, body.radius)`` as the collision mask of an
+  agent's centre.
+* :class:`Planner` - global planning on the grid: geodesic distance fields (Dijkstra)
+  and minimum-cost paths (A*) on 8-connected moves, with a cost that keeps paths clear
+  of walls like move_base's inflation decay.
+* :class:`PathFollower` - a pure-pursuit local controller for a unicycle.
+
+Units and frames: positions are map-frame (x, y) in metres (ROS conventions, see
+:mod:`pegame.maps`), headings and angles in radians, speeds in m/s and rad/s. Grid
+arrays are (height, width) indexed [row, col] with row 0 the lowest y; distances and
+costs are in metres.
+
+Grid moves: a path steps between the centres of 8-neighbouring traversable cells; a
+diagonal step is allowed only when both cells it passes between are traversable too,
+so the straight segment never touches a non-traversable cell (no corner cutting). As a
+consequence two cells are connected exactly when they are 4-connected.
+
+The search kernels are compiled with numba; ``_distance_field_reference`` and
+``_astar_reference`` are plain-Python implementations of the same algorithms that the
+tests compare the kernels against.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+from scipy import ndimage
+
+from pegame.api import STOP, Body, Pose, Velocity, wrap_angle
+from pegame.maps import OccupancyGrid
+
+SQRT2 = math.sqrt(2.0)
+
+#: the 8 moves as (row step, col step); orthogonal moves first
+_MOVES = np.array(
+    [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)], dtype=np.int64
+)
+
+#: distances equal to the radius up to float rounding count as within it (m)
+_DISTANCE_TOLERANCE = 1e-9
+
+
+# --------------------------------------------------------------------------- inflation
+
+
+def obstacle_distance(grid: OccupancyGrid) -> np.ndarray:
+    """Float64 (H, W): distance (m) from each cell centre to the nearest blocked cell centre.
+
+    Blocked cells (occupied or unknown) are at distance 0, and every cell outside the grid
+    counts as blocked, so no cell is farther than its distance to the ring of cells just
+    outside the border.
+    """
+    # One ring of blocked padding is enough: the nearest outside cell is always in it.
+    free = np.pad(~grid.blocked, 1, constant_values=False)
+    distance = ndimage.distance_transform_edt(free, sampling=grid.resolution)
+    return distance[1:-1, 1:-1]
+
+
+def inflate(grid: OccupancyGrid, radius: float) -> np.ndarray:
+    """Bool (H, W): True where a disc of ``radius`` (m) centred on the cell centre would
+    contain the centre of a blocked cell, counting cells outside the grid as blocked.
+
+    Blocked cells are always True. An agent's centre may never lie in a True cell of
+    ``inflate(grid, body.radius)``.
+    """
+    return obstacle_distance(grid) <= radius + _DISTANCE_TOLERANCE
+
+
+# ----------------------------------------------------------------------- numba kernels
+# The priority queue is an indexed binary min-heap over flat cell indices with
+# decrease-key: keys (primary) and ties (secondary) per slot, nodes per slot, and pos[node]
+# the node's slot or -1 when it is not queued. Ties favour the smaller secondary key.
+
+
+@njit(cache=True)
+def _sift_up(keys, ties, nodes, pos, slot, node, key, tie):
+    while slot > 0:
+        parent = (slot - 1) >> 1
+        if keys[parent] < key or (keys[parent] == key and ties[parent] <= tie):
+            break
+        keys[slot] = keys[parent]
+        ties[slot] = ties[parent]
+        nodes[slot] = nodes[parent]
+        pos[nodes[slot]] = slot
+        slot = parent
+    keys[slot] = key
+    ties[slot] = tie
+    nodes[slot] = node
+    pos[node] = slot
+
+
+@njit(cache=True)
+def _pop(keys, ties, nodes, pos, size):
+    """Remove and return the minimum node; the caller decrements its heap size."""
+    top = nodes[0]
+    pos[top] = -1
+    size -= 1
+    if size == 0:
+        return top
+    node, key, tie = nodes[size], keys[size], ties[size]
+    slot = 0
+    while True:
+        child = 2 * slot + 1
+        if child >= size:
+            break
+        right = child + 1
+        if right < size and (
+            keys[right] < keys[child] or (keys[right] == keys[child] and ties[right] < ties[child])
+        ):
+            child = right
+        if key < keys[child] or (key == keys[child] and tie <= ties[child]):
+            break
+        keys[slot] = keys[child]
+        ties[slot] = ties[child]
+        nodes[slot] = nodes[child]
+        pos[nodes[slot]] = slot
+        slot = child
+    keys[slot] = key
+    ties[slot] = tie
+    nodes[slot] = node
+    pos[node] = slot
+    return top
+
+
+@njit(cache=True)
+def _step_cost(traversable, multipliers, weighted, resolution, r, c, k, moves):
+    """Cost (m) of move k from cell (r, c), or -1 when the move is not allowed."""
+    height, width = traversable.shape
+    dr, dc = moves[k, 0], moves[k, 1]
+    nr, nc = r + dr, c + dc
+    if nr < 0 or nr >= height or nc < 0 or nc >= width or not traversable[nr, nc]:
+        return -1.0
+    step = resolution
+    if dr != 0 and dc != 0:
+        if not (traversable[r, nc] and traversable[nr, c]):
+            return -1.0
+        step = resolution * SQRT2
+    if weighted:
+        return step * (0.5 * (multipliers[r, c] + multipliers[nr, nc]))
+    return step
+
+
+@njit(cache=True)
+def _dijkstra(traversable, multipliers, weighted, resolution, source, moves):
+    """Shortest-path cost (m) from flat cell ``source`` to every cell; inf if unreachable."""
+    height, width = traversable.shape
+    n = height * width
+    dist = np.full(n, np.inf)
+    keys = np.empty(n)
+    ties = np.zeros(n)
+    nodes = np.empty(n, dtype=np.int64)
+    pos = np.full(n, -1, dtype=np.int64)
+    dist[source] = 0.0
+    _sift_up(keys, ties, nodes, pos, 0, source, 0.0, 0.0)
+    size = 1
+    while size > 0:
+        u = _pop(keys, ties, nodes, pos, size)
+        size -= 1
+        r, c = u // width, u % width
+        for k in range(8):
+            cost = _step_cost(traversable, multipliers, weighted, resolution, r, c, k, moves)
+            if cost < 0.0:
+                continue
+            v = (r + moves[k, 0]) * width + c + moves[k, 1]
+            candidate = dist[u] + cost
+            if candidate < dist[v]:
+                dist[v] = candidate
+                if pos[v] < 0:
+                    _sift_up(keys, ties, nodes, pos, size, v, candidate, 0.0)
+                    size += 1
+                else:
+                    _sift_up(keys, ties, nodes, pos, pos[v], v, candidate, 0.0)
+    return dist.reshape((height, width))
+
+
+@njit(cache=True)
+def _octile(resolution, r, c, goal_r, goal_c):
+    dr, dc = abs(r - goal_r), abs(c - goal_c)
+    return resolution * (max(dr, dc) + (SQRT2 - 1.0) * min(dr, dc))
+
+
+@njit(cache=True)
+def _astar(traversable, multipliers, resolution, start, goal, moves):
+    """Minimum weighted cost (m) and flat cell path from ``start`` to ``goal`` by A*.
+
+    The octile heuristic is admissible and consistent because every multiplier is >= 1.
+    Returns (inf, empty) when the goal is unreachable.
+    """
+    height, width = traversable.shape
+    n = height * width
+    goal_r, goal_c = goal // width, goal % width
+    g = np.full(n, np.inf)
+    parent = np.full(n, -1, dtype=np.int64)
+    keys = np.empty(n)
+    ties = np.empty(n)
+    nodes = np.empty(n, dtype=np.int64)
+    pos = np.full(n, -1, dtype=np.int64)
+    g[start] = 0.0
+    h0 = _octile(resolution, start // width, start % width, goal_r, goal_c)
+    _sift_up(keys, ties, nodes, pos, 0, start, h0, h0)
+    size = 1
+    while size > 0:
+        u = _pop(keys, ties, nodes, pos, size)
+        size -= 1
+        if u == goal:
+            break
+        r, c = u // width, u % width
+        for k in range(8):
+            cost = _step_cost(traversable, multipliers, True, resolution, r, c, k, moves)
+            if cost < 0.0:
+                continue
+            nr, nc = r + moves[k, 0], c + moves[k, 1]
+            v = nr * width + nc
+            candidate = g[u] + cost
+            if candidate < g[v]:
+                g[v] = candidate
+                parent[v] = u
+                h = _octile(resolution, nr, nc, goal_r, goal_c)
+                # Equal f: prefer the smaller h (the deeper node) so open areas are not
+                # flooded with ties.
+                if pos[v] < 0:
+                    _sift_up(keys, ties, nodes, pos, size, v, candidate + h, h)
+                    size += 1
+                else:
+                    _sift_up(keys, ties, nodes, pos, pos[v], v, candidate + h, h)
+    if not np.isfinite(g[goal]):
+        return np.inf, np.empty(0, dtype=np.int64)
+    count = 1
+    node = goal
+    while node != start:
+        node = parent[node]
+        count += 1
+    path = np.empty(count, dtype=np.int64)
+    node = goal
+    for i in range(count - 1, -1, -1):
+        path[i] = node
+        node = parent[node]
+    return g[goal], path
+
+
+# -------------------------------------------------------------- plain-Python references
+
+
+def _reference_neighbours(traversable, multipliers, weighted, resolution, cell):
+    """Yield (neighbour cell, step cost m) for the allowed moves from ``cell``."""
+    height, width = traversable.shape
+    r, c = cell
+    for dr, dc in _MOVES.tolist():
+        nr, nc = r + dr, c + dc
+        if not (0 <= nr < height and 0 <= nc < width and traversable[nr, nc]):
+            continue
+        step = resolution
+        if dr and dc:
+            if not (traversable[r, nc] and traversable[nr, c]):
+                continue
+            step = resolution * SQRT2
+        if weighted:
+            step = step * (0.5 * (multipliers[r, c] + multipliers[nr, nc]))
+        yield (nr, nc), step
+
+
+def _distance_field_reference(traversable, multipliers, weighted, resolution, source):
+    """Plain-Python Dijkstra with heapq; same contract as :func:`_dijkstra` but takes and
+    returns (row, col) cells: float64 (H, W) costs (m) from ``source``, inf if unreachable."""
+    dist = np.full(traversable.shape, np.inf)
+    dist[source] = 0.0
+    queue = [(0.0, source)]
+    while queue:
+        d, cell = heapq.heappop(queue)
+        if d > dist[cell]:
+            continue
+        for nxt, step in _reference_neighbours(traversable, multipliers, weighted, resolution, cell):
+            if d + step < dist[nxt]:
+                dist[nxt] = d + step
+                heapq.heappush(queue, (d + step, nxt))
+    return dist
+
+
+def _astar_reference(traversable, multipliers, resolution, start, goal):
+    """Plain-Python A* with heapq and the octile heuristic on the weighted grid.
+
+    Returns (cost m, list of (row, col) cells from start to goal), or (inf, []).
+    """
+
+    def heuristic(cell):
+        dr, dc = abs(cell[0] - goal[0]), abs(cell[1] - goal[1])
+        return resolution * (max(dr, dc) + (SQRT2 - 1.0) * min(dr, dc))
+
+    g = {start: 0.0}
+    parent = {start: None}
+    queue = [(heuristic(start), start)]
+    while queue:
+        f, cell = heapq.heappop(queue)
+        if cell == goal:
+            break
+        if f > g[cell] + heuristic(cell):
+            continue
+        for nxt, step in _reference_neighbours(traversable, multipliers, True, resolution, cell):
+            if g[cell] + step < g.get(nxt, math.inf):
+                g[nxt] = g[cell] + step
+                parent[nxt] = cell
+                heapq.heappush(queue, (g[nxt] + heuristic(nxt), nxt))
+    if goal not in g:
+        return math.inf, []
+    path = [goal]
+    while parent[path[-1]] is not None:
+        path.append(parent[path[-1]])
+    return g[goal], path[::-1]
+
+
+# ---------------------------------------------------------------------------- planner
+
+
+@dataclass(frozen=True, eq=False)
+class PathResult:
+    """A planned path.
+
+    path: float (K, 2) map-frame waypoints (m) from start to goal: cell centres, then the
+    exact goal point when its cell is traversable; empty when unreachable. length: the
+    polyline length of ``path`` (m). cost: the weighted grid cost of the cell path (m,
+    see :class:`Planner`); inf when unreachable. reachable: whether a path was found.
+    reason: '' when reachable, else why not.
+    """
+
+    path: np.ndarray
+    length: float
+    reachable: bool
+    reason: str = ""
+    cost: float = math.inf
+
+
+def _unreachable(reason: str) -> PathResult:
+    return PathResult(np.zeros((0, 2)), 0.0, False, reason)
+
+
+class Planner:
+    """Global planner on one map for one agent size.
+
+    grid: the occupancy map. radius: the agent's radius (m). margin (m): extra inflation
+    so planned paths stay executable by an agent whose collision mask is
+    ``inflate(grid, radius)``; a cell is traversable when it is outside
+    ``inflate(grid, radius + margin)``. clearance (m) and clearance_weight: a traversable
+    cell whose centre is d metres beyond the inflation zone (d = obstacle distance -
+    radius - margin) costs ``1 + clearance_weight * max(0, 1 - d / clearance)`` times its
+    length, so paths keep clear of walls when they can (no extra cost when clearance is
+    0). goal_snap (m): how far a goal in a non-traversable cell may be moved (see
+    :meth:`plan`).
+    """
+
+    def __init__(
+        self,
+        grid: OccupancyGrid,
+        radius: float,
+        margin: float = 0.05,
+        clearance: float = 0.5,
+        clearance_weight: float = 2.0,
+        goal_snap: float = 1.0,
+    ) -> None:
+        self.grid = grid
+        self.radius = radius
+        self.goal_snap = goal_snap
+        inflation = radius + margin
+        distance = obstacle_distance(grid)
+        self.traversable = distance > inflation + _DISTANCE_TOLERANCE
+        beyond = distance - inflation
+        if clearance > 0:
+            penalty = np.clip(1.0 - beyond / clearance, 0.0, 1.0)
+        else:
+            penalty = np.zeros_like(distance)
+        self.multipliers = 1.0 + clearance_weight * penalty
+        # Components under the planner's moves: without corner cutting these are the
+        # 4-connected components (labels 1.., 0 for non-traversable cells).
+        self._labels, _ = ndimage.label(self.traversable)
+        self._any_traversable = bool(self.traversable.any())
+        # For every cell, the index of the nearest traversable cell (by centre distance).
+        _, self._nearest = ndimage.distance_transform_edt(~self.traversable, return_indices=True)
+
+    # -- cells
+
+    def _cell(self, xy) -> tuple[int, int]:
+        """The (row, col) containing map point xy (m), clamped into the grid."""
+        row, col = self.grid.world_to_cell(xy[0], xy[1])
+        return min(max(row, 0), self.grid.height - 1), min(max(col, 0), self.grid.width - 1)
+
+    def _is_traversable(self, xy) -> bool:
+        row, col = self.grid.world_to_cell(xy[0], xy[1])
+        return bool(self.grid.contains(row, col)) and bool(self.traversable[row, col])
+
+    def _source_cell(self, xy) -> tuple[int, int] | None:
+        """xy's cell if traversable, else the traversable cell whose centre is nearest to the
+        centre of xy's cell (clamped into the grid); None if no cell is traversable."""
+        if not self._any_traversable:
+            return None
+        row, col = self._cell(xy)
+        return int(self._nearest[0, row, col]), int(self._nearest[1, row, col])
+
+    def nearest_traversable(self, xy) -> tuple[float, float] | None:
+        """Map-frame centre (m) of the traversable cell nearest to xy's cell (xy itself
+        when its cell is traversable, up to the cell centre); None if none is traversable."""
+        cell = self._source_cell(xy)
+        return None if cell is None else self.grid.cell_to_world(*cell)
+
+    def reachable(self, xy) -> np.ndarray:
+        """Bool (H, W): the traversable cells connected to xy's cell (or to the nearest
+        traversable cell when xy's cell is not traversable)."""
+        cell = self._source_cell(xy)
+        if cell is None:
+            return np.zeros(self.traversable.shape, dtype=bool)
+        return self._labels == self._labels[cell]
+
+    # -- searches
+
+    def distance_field(self, xy, weighted: bool = False) -> np.ndarray:
+        """Float64 (H, W): least path cost (m) from xy's cell to every cell over traversable
+        cells, np.inf where unreachable. Unweighted, this is the geodesic distance; weighted,
+        each step costs its length times the mean multiplier of its two cells. When xy's
+        cell is not traversable the search starts from the nearest traversable cell."""
+        cell = self._source_cell(xy)
+        if cell is None:
+            return np.full(self.traversable.shape, np.inf)
+        source = cell[0] * self.grid.width + cell[1]
+        return _dijkstra(
+            self.traversable, self.multipliers, weighted, self.grid.resolution, source, _MOVES
+        )
+
+    def _snap_goal(self, goal_xy, label: int) -> tuple[int, int] | None:
+        """The cell with ``label`` whose centre is nearest to goal_xy and within goal_snap."""
+        res = self.grid.resolution
+        row, col = self.grid.world_to_cell(goal_xy[0], goal_xy[1])
+        k = int(math.ceil(self.goal_snap / res)) + 1
+        r0, r1 = max(row - k, 0), min(row + k + 1, self.grid.height)
+        c0, c1 = max(col - k, 0), min(col + k + 1, self.grid.width)
+        if r0 >= r1 or c0 >= c1:
+            return None
+        rows, cols = np.nonzero(self._labels[r0:r1, c0:c1] == label)
+        if rows.size == 0:
+            return None
+        rows, cols = rows + r0, cols + c0
+        x, y = self.grid.cell_to_world(rows, cols)
+        d = np.hypot(x - goal_xy[0], y - goal_xy[1])
+        best = int(np.argmin(d))
+        if d[best] > self.goal_snap + _DISTANCE_TOLERANCE:
+            return None
+        return int(rows[best]), int(cols[best])
+
+    def plan(self, start_xy, goal_xy) -> PathResult:
+        """Minimum weighted cost path from start_xy to goal_xy (map frame, m); never raises.
+
+        A start outside the traversable cells (an agent touching the inflation zone) plans
+        from the nearest traversable cell. A goal whose cell is not traversable (near a wall,
+        inside an obstacle, off the map) is moved to the nearest cell reachable from the
+        start within goal_snap metres, and the path ends at that cell's centre; with none
+        there the result is unreachable. A goal in a traversable cell that the start cannot
+        reach is unreachable (it is never moved to the other side of a wall).
+        """
+        start = self._source_cell(start_xy)
+        if start is None:
+            return _unreachable("no traversable cell in the map")
+        label = self._labels[start]
+        exact_goal = self._is_traversable(goal_xy)
+        if exact_goal:
+            goal = self.grid.world_to_cell(goal_xy[0], goal_xy[1])
+            if self._labels[goal] != label:
+                return _unreachable("goal is not reachable from start")
+        else:
+            goal = self._snap_goal(goal_xy, label)
+            if goal is None:
+                row, col = self.grid.world_to_cell(goal_xy[0], goal_xy[1])
+                if not self.grid.contains(row, col):
+                    return _unreachable("goal is outside the map")
+                return _unreachable("goal is inside an obstacle")
+        width = self.grid.width
+        cost, cells = _astar(
+            self.traversable,
+            self.multipliers,
+            self.grid.resolution,
+            start[0] * width + start[1],
+            goal[0] * width + goal[1],
+            _MOVES,
+        )
+        x, y = self.grid.cell_to_world(cells // width, cells % width)
+        path = np.column_stack([x, y])
+        if exact_goal:
+            path = np.vstack([path, np.asarray(goal_xy, dtype=float).reshape(1, 2)])
+        length = float(np.hypot(*np.diff(path, axis=0).T).sum())
+        return PathResult(path, length, True, "", float(cost))
+
+
+# ---------------------------------------------------------------------- path follower
+
+
+class PathFollower:
+    """Pure-pursuit controller that drives a unicycle along a waypoint path.
+
+    body: the agent's limits (v_max m/s, w_max rad/s). lookahead (m): arc length ahead of
+    the agent's progress point that it steers towards. goal_tolerance (m): the path is
+    done once the agent is this close to its last waypoint. rotate_threshold (rad): above
+    this heading error to the lookahead point the agent turns in place. turn_gain (1/s):
+    turn rate per radian of heading error when turning in place.
+    """
+
+    def __init__(
+        self,
+        body: Body,
+        lookahead: float = 0.5,
+        goal_tolerance: float = 0.15,
+        rotate_threshold: float = math.pi / 3,
+        turn_gain: float = 2.0,
+    ) -> None:
+        self.body = body
+        self.lookahead = lookahead
+        self.goal_tolerance = goal_tolerance
+        self.rotate_threshold = rotate_threshold
+        self.turn_gain = turn_gain
+        self.set_path(np.zeros((0, 2)))
+
+    def set_path(self, path) -> None:
+        """Follow ``path``, float (K, 2) map-frame waypoints (m); an empty path stops."""
+        self.path = np.asarray(path, dtype=float).reshape(-1, 2)
+        seg = np.diff(self.path, axis=0)
+        self._seg_len = np.hypot(seg[:, 0], seg[:, 1])
+        self._arc = np.concatenate([[0.0], np.cumsum(self._seg_len)])  # arc length at waypoints
+        self._progress = 0.0  # arc length (m) of the agent's projection; only grows
+        self._done = len(self.path) == 0
+
+    @property
+    def done(self) -> bool:
+        """True once the agent came within goal_tolerance of the last waypoint (or no path)."""
+        return self._done
+
+    @property
+    def remaining(self) -> float:
+        """Path length (m) from the agent's progress point to the end; 0 when done."""
+        return 0.0 if self._done else float(self._arc[-1] - self._progress)
+
+    def _advance(self, xy: np.ndarray) -> None:
+        """Move the progress point forward to the closest point on the path nearby.
+
+        Only segments starting within two lookaheads of the current progress are searched,
+        so a path that passes near itself does not make the agent skip ahead.
+        """
+        if len(self._seg_len) == 0:
+            return
+        first = int(np.searchsorted(self._arc, self._progress, side="right")) - 1
+        first = min(first, len(self._seg_len) - 1)
+        last = int(np.searchsorted(self._arc, self._progress + 2 * self.lookahead, side="right"))
+        last = min(max(last, first + 1), len(self._seg_len))
+        a = self.path[first:last]
+        d = self.path[first + 1 : last + 1] - a
+        lengths = self._seg_len[first:last]
+        t = np.einsum("ij,ij->i", xy - a, d) / np.maximum(lengths**2, 1e-18)
+        t = np.clip(t, 0.0, 1.0)
+        gap = np.hypot(*(a + t[:, None] * d - xy).T)
+        best = int(np.argmin(gap))
+        arc = self._arc[first + best] + t[best] * lengths[best]
+        self._progress = max(self._progress, float(arc))
+
+    def _point_at(self, arc: float) -> np.ndarray:
+        """The path point (m) at arc length ``arc``, clamped to the path's ends."""
+        if arc >= self._arc[-1]:
+            return self.path[-1]
+        i = int(np.searchsorted(self._arc, arc, side="right")) - 1
+        t = (arc - self._arc[i]) / max(self._seg_len[i], 1e-18)
+        return self.path[i] + t * (self.path[i + 1] - self.path[i])
+
+    def command(self, pose: Pose) -> Velocity:
+        """The velocity command for the agent at ``pose`` (map frame).
+
+        Turns in place (v = 0) when the heading error to the lookahead point exceeds
+        rotate_threshold; otherwise drives the pure-pursuit arc through that point at a
+        speed reduced within one lookahead of the goal and so that the turn rate stays
+        within w_max.
+        """
+        if self._done:
+            return STOP
+        xy = np.array([pose.x, pose.y])
+        to_goal = float(np.hypot(*(self.path[-1] - xy)))
+        if to_goal <= self.goal_tolerance:
+            self._done = True
+            return STOP
+        self._advance(xy)
+        target = self._point_at(self._progress + self.lookahead)
+        dx, dy = target - xy
+        error = wrap_angle(math.atan2(dy, dx) - pose.theta)
+        v_max, w_max = self.body.v_max, self.body.w_max
+        if abs(error) > self.rotate_threshold:
+            return Velocity(0.0, _clamp(self.turn_gain * error, w_max))
+        # Pure pursuit: the arc through the target tangent to the heading has curvature
+        # 2 sin(error) / distance.
+        curvature = 2.0 * math.sin(error) / max(math.hypot(dx, dy), 1e-9)
+        v = v_max * min(1.0, max(self.remaining, to_goal) / self.lookahead)
+        if abs(curvature) * v > w_max:
+            v = w_max / abs(curvature)
+        return Velocity(v, _clamp(curvature * v, w_max))
+
+
+def _clamp(value: float, limit: float) -> float:
+    return max(-limit, min(limit, value))

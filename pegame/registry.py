@@ -1,0 +1,126 @@
+"""Entry-point registries: lazy lookup of plugins by name, with clear errors.
+
+Each config group (``sim``, ``detector``, ...) has an entry-point group
+``pegame.<plural>``; a plugin's entry-point name equals its config file stem and the
+``name:`` key inside it. Nothing is imported until a plugin is asked for, so
+``import pegame`` loads no plugin. Built-in plugins register through the same entry
+points (in pegame's own pyproject.toml) as third-party ones.
+"""
+
+from __future__ import annotations
+
+import difflib
+from functools import lru_cache
+from importlib.metadata import EntryPoint, entry_points
+from typing import Any, Mapping
+
+
+from pegame.errors import PegameError
+
+#: config group -> entry-point group
+GROUPS: dict[str, str] = {
+    "sim": "pegame.simulators",
+    "detector": "pegame.detectors",
+    "estimator": "pegame.estimators",
+    "pursuer": "pegame.pursuers",
+    "evader": "pegame.evaders",
+    "recorder": "pegame.recorders",
+}
+
+
+class PluginError(PegameError, LookupError):
+    """A plugin is unknown, fails to import, or does not implement its interface."""
+
+
+def _entry_point_group(group: str) -> str:
+    try:
+        return GROUPS[group]
+    except KeyError:
+        raise PluginError(
+            f"Unknown plugin group '{group}'. Available: {', '.join(GROUPS)}."
+        ) from None
+
+
+@lru_cache(maxsize=None)
+def _entry_points(group: str) -> dict[str, EntryPoint]:
+    found = entry_points(group=_entry_point_group(group))
+    return {ep.name: ep for ep in sorted(found, key=lambda ep: ep.name)}
+
+
+def available(group: str) -> list[str]:
+    """Names registered in ``group`` (for example ``available('pursuer')``), sorted."""
+    return list(_entry_points(group))
+
+
+def entry_point(group: str, name: str) -> EntryPoint:
+    """The entry point of plugin ``name`` in ``group``; PluginError with suggestions if unknown."""
+    points = _entry_points(group)
+    if name in points:
+        return points[name]
+    close = difflib.get_close_matches(str(name), points, n=1)
+    hint = f" Did you mean '{close[0]}'?" if close else ""
+    raise PluginError(
+        f"Unknown {group} '{name}'.{hint} Available: {', '.join(points) or '(none)'}. "
+        f"Plugins register under the entry-point group '{GROUPS[group]}'."
+    )
+
+
+def distribution_of(point: EntryPoint) -> str:
+    """The name of the distribution that provides ``point``, or '?' when unknown."""
+    dist = getattr(point, "dist", None)
+    return dist.name if dist is not None else "?"
+
+
+def load(group: str, name: str) -> type:
+    """Import and return the plugin class ``name`` of ``group``, checking its interface."""
+    from pegame.api import INTERFACES  # the interfaces are light; plugins are not
+
+    point = entry_point(group, name)
+    try:
+        cls = point.load()
+    except ImportError as exc:
+        missing = getattr(exc, "name", None)
+        hint = (
+            f" It needs the package '{missing}': install it (pip install {missing}) or "
+            f"reinstall the plugin's distribution with its dependencies."
+            if missing
+            else ""
+        )
+        raise PluginError(
+            f"The {group} plugin '{name}' (distribution '{distribution_of(point)}', "
+            f"{point.value}) failed to import: {exc}.{hint}"
+        ) from exc
+    interface = INTERFACES[group]
+    if not (isinstance(cls, type) and issubclass(cls, interface)):
+        raise TypeError(
+            f"The {group} plugin '{name}' ({point.value}) must be a subclass of "
+            f"pegame.api.{interface.__name__}, got {cls!r}."
+        )
+    abstract = sorted(getattr(cls, "__abstractmethods__", ()))
+    if abstract:
+        raise TypeError(
+            f"The {group} plugin '{name}' ({point.value}) does not implement "
+            f"{interface.__name__}: missing {', '.join(abstract)}."
+        )
+    return cls
+
+
+def make_config(group: str, cls: type, params: Mapping[str, Any]) -> Any:
+    """Build a validated ``cls.Config`` from a config node's ``params`` (without ``name``);
+    ConfigError names ``group.key`` and the allowed keys or range."""
+    from pegame.config import typed
+
+    return typed(params, cls.Config, group)
+
+
+def describe(group: str) -> list[tuple[str, str, str]]:
+    """(name, distribution, one-line description) of every plugin in ``group``; loads them."""
+    rows = []
+    for name, point in _entry_points(group).items():
+        try:
+            text = (load(group, name).description or "").strip().splitlines()[0:1]
+            text = text[0] if text else ""
+        except (PluginError, TypeError) as exc:
+            text = f"(broken: {exc})"
+        rows.append((name, distribution_of(point), text))
+    return rows
