@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields, make_dataclass
 from pathlib import Path
-from typing import Any, Mapping, get_type_hints
+from typing import Any, Mapping, Sequence, get_type_hints
 
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
@@ -116,3 +116,14 @@ def typed(node: Mapping[str, Any], schema: type, key: str) -> Any:
         where = f"{key}.{exc.full_key}" if getattr(exc, "full_key", None) else key
         reason = str(exc).splitlines()[0]
         raise ConfigError(f"Invalid value for '{where}': {reason}.") from None
+
+
+def compose(overrides: Sequence[str] = ()) -> DictConfig:
+    """The config the app would receive for these command-line ``overrides``, composed
+    without running the app (for scripts, benchmarks and tests)."""
+    from hydra import compose as hydra_compose
+    from hydra import initialize_config_module
+
+    register_schema()
+    with initialize_config_module(config_module="pegame.conf", version_base=None):
+        return hydra_compose(config_name="config", overrides=list(overrides))

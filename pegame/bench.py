@@ -1,0 +1,234 @@
+"""``python -m pegame.bench [--json] [--quick]``: speed of the kernels and of whole games.
+
+Every figure is a median over repeated runs in one process on one core (no kernel here
+is multi-threaded), measured together so that ratios between figures are meaningful on a noisy
+machine. Numba kernels are compiled (or loaded from cache) by a warm-up call first; the
+first-call cost is reported separately as ``jit_warmup_s``. Keys whose piece does not exist
+yet are null.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import resource
+import statistics
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from pegame import registry
+from pegame.api import Body, Camera, Context, EvaderObservation, Pose, PursuerObservation
+from pegame.config import compose, resolve_map_path
+from pegame.game import Game
+from pegame.geometry import visibility_region
+from pegame.maps import OccupancyGrid, load_map
+from pegame.navigation import Planner
+
+PAPER_MAPS = ("hall", "enclosed", "brick")
+
+
+def median_ms(fn: Callable[[], Any], repeat: int) -> float:
+    """Median wall time of ``fn()`` over ``repeat`` calls, milliseconds."""
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return 1e3 * statistics.median(times)
+
+
+def machine() -> dict[str, Any]:
+    """A description of this machine for the report."""
+    cpu = "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "platform": platform.platform(),
+    }
+
+
+def free_poses(grid: OccupancyGrid, radius: float, n: int, seed: int = 0) -> list[Pose]:
+    """``n`` random poses on cells traversable for a disc of ``radius`` m."""
+    rng = np.random.default_rng(seed)
+    rows, cols = np.nonzero(Planner(grid, radius).traversable)
+    picks = rng.integers(rows.size, size=n)
+    return [Pose(*grid.cell_to_world(rows[k], cols[k]), float(rng.uniform(-math.pi, math.pi))) for k in picks]
+
+
+def bench_visibility(grid: OccupancyGrid, repeat: int) -> float:
+    poses = iter(free_poses(grid, 0.2, repeat + 1) * 2)
+    camera = Camera()
+    return median_ms(lambda: visibility_region(grid, next(poses), camera), repeat)
+
+
+def bench_planner(grid: OccupancyGrid, repeat: int) -> tuple[float, float]:
+    """(distance field ms, start-to-goal plan ms) for the pursuer's planner."""
+    planner = Planner(grid, 0.2)
+    starts = iter(free_poses(grid, 0.2, 2 * repeat + 2, seed=1) * 2)
+    field_ms = median_ms(lambda: planner.distance_field(next(starts).xy), repeat)
+    plan_ms = median_ms(lambda: planner.plan(next(starts).xy, next(starts).xy), repeat)
+    return field_ms, plan_ms
+
+
+def bench_sim_steps(grid: OccupancyGrid, steps: int) -> float:
+    """Grid-simulator control steps per second (both agents moving)."""
+    from pegame.api import Velocity
+    from pegame.sims.grid import GridSimulator
+
+    context = Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
+    sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
+    p, e = free_poses(grid, 0.25, 2, seed=2)
+    sim.reset(p, e)
+    cmd = Velocity(0.4, 0.3)
+    start = time.perf_counter()
+    for _ in range(steps):
+        sim.step(cmd, cmd, 0.1)
+    return steps / (time.perf_counter() - start)
+
+
+def games_per_second(overrides: list[str], games: int, out_dir: str) -> float:
+    """Whole games per second (median game time), recorder as the overrides say."""
+    times = []
+    for seed in range(games):
+        game = Game(compose([*overrides, f"game.seed={seed}"]))
+        start = time.perf_counter()
+        game.play(out_dir)
+        times.append(time.perf_counter() - start)
+    return 1.0 / statistics.median(times)
+
+
+def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]:
+    """ms per decision of the smart pursuer (estimator update + plan) and smart evader."""
+    out: dict[str, float | None] = {"pursuer_decision_ms": None, "evader_decision_ms": None, "pf_step_ms": None}
+    camera = Camera()
+    context = Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), camera, 0.1, 1.0)
+    poses = free_poses(grid, 0.25, 2 * repeat + 2, seed=3)
+    pairs = list(zip(poses[::2], poses[1::2]))
+    if "particle_filter" in registry.available("estimator"):
+        cls = registry.load("estimator", "particle_filter")
+        pf = cls(registry.make_config("estimator", cls, {}), context, np.random.default_rng(0))
+        p0 = pairs[0][0]
+        pf.reset(p0, None, visibility_region(grid, p0, camera))
+        masks = [visibility_region(grid, p, camera) for p, _ in pairs]
+        it = iter(list(zip(pairs, masks)) * 2)
+
+        def pf_step():
+            (p, _), mask = next(it)
+            return pf.update(0.1, p, None, mask)
+
+        out["pf_step_ms"] = median_ms(pf_step, repeat)
+        if "smart" in registry.available("pursuer"):
+            pcls = registry.load("pursuer", "smart")
+            pursuer = pcls(registry.make_config("pursuer", pcls, {}), context, np.random.default_rng(1))
+            pursuer.reset(p0)
+            it2 = iter(list(zip(pairs, masks)) * 2)
+
+            def pursuer_decision():
+                (p, _), mask = next(it2)
+                belief = pf.update(0.1, p, None, mask)
+                return pursuer.decide(PursuerObservation(0.0, p, None, belief, mask))
+
+            out["pursuer_decision_ms"] = median_ms(pursuer_decision, repeat)
+    if "smart" in registry.available("evader"):
+        ecls = registry.load("evader", "smart")
+        evader = ecls(registry.make_config("evader", ecls, {}), context, np.random.default_rng(2))
+        evader.reset(pairs[0][1])
+        it3 = iter(pairs * 2)
+
+        def evader_decision():
+            p, e = next(it3)
+            return evader.decide(EvaderObservation(0.0, e, p))
+
+        out["evader_decision_ms"] = median_ms(evader_decision, repeat)
+    return out
+
+
+def main(argv: list[str] | None = None) -> dict[str, Any]:
+    parser = argparse.ArgumentParser(prog="python -m pegame.bench", description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--quick", action="store_true", help="fewer repetitions (under a minute)")
+    args = parser.parse_args(argv)
+    repeat, games = (20, 2) if args.quick else (200, 5)
+
+    report: dict[str, Any] = {"machine": machine()}
+    grids = {name: load_map(resolve_map_path(f"{name}.yaml")) for name in PAPER_MAPS}
+    start = time.perf_counter()
+    bench_visibility(grids["hall"], 1)
+    Planner(grids["hall"], 0.2).plan(*[p.xy for p in free_poses(grids["hall"], 0.2, 2)])
+    report["jit_warmup_s"] = time.perf_counter() - start
+
+    per_map: dict[str, dict[str, Any]] = {}
+    for name, grid in grids.items():
+        field_ms, plan_ms = bench_planner(grid, repeat)
+        per_map[name] = {
+            "cells": [grid.height, grid.width],
+            "visibility_ms": bench_visibility(grid, repeat),
+            "distance_field_ms": field_ms,
+            "plan_ms": plan_ms,
+            **bench_decisions(grid, max(10, repeat // 4)),
+        }
+    report["maps"] = per_map
+    for key in ("visibility_ms", "distance_field_ms", "plan_ms", "pf_step_ms"):
+        values = [m[key] for m in per_map.values() if m.get(key) is not None]
+        report[key] = max(values) if values else None  # the worst paper map
+    report["sim_steps_per_s"] = bench_sim_steps(grids["enclosed"], 2000 if args.quick else 20000)
+
+    with tempfile.TemporaryDirectory() as tmp:
+        rr = ["pursuer=random", "evader=random", "recorder=none", "env=enclosed"]
+        report["rr_games_per_s"] = games_per_second(rr, games, tmp)
+        smart = all("smart" in registry.available(g) for g in ("pursuer", "evader"))
+        ss = ["pursuer=smart", "evader=smart", "recorder=none", "env=enclosed"]
+        report["ss_games_per_s"] = games_per_second(ss, games, tmp) if smart else None
+    for key in ("large_map_decision_ms", "large_map_peak_mb", "recorder_overhead", "rrd_mb_per_game",
+                "pybullet_rtf", "vision_precision", "vision_recall", "env_steps_per_s"):
+        report.setdefault(key, None)
+    report["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        print(format_report(report))
+    return report
+
+
+def fmt(value: float | None) -> str:
+    """A figure with two decimals, or '-' when it was not measured."""
+    return "-" if value is None else f"{value:.2f}"
+
+
+def format_report(report: dict[str, Any]) -> str:
+    """The report as aligned text lines."""
+    m = report["machine"]
+    lines = [f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}, numpy {m['numpy']}"]
+    lines.append(f"jit warm-up (first calls): {report['jit_warmup_s']:.2f} s")
+    lines.append(f"{'map':<10}{'cells':>10}{'visib ms':>10}{'field ms':>10}{'plan ms':>9}"
+                 f"{'pf ms':>8}{'P dec ms':>10}{'E dec ms':>10}")
+    for name, row in report["maps"].items():
+        cells = "x".join(map(str, row["cells"]))
+        lines.append(f"{name:<10}{cells:>10}{fmt(row['visibility_ms']):>10}{fmt(row['distance_field_ms']):>10}"
+                     f"{fmt(row['plan_ms']):>9}{fmt(row.get('pf_step_ms')):>8}"
+                     f"{fmt(row.get('pursuer_decision_ms')):>10}{fmt(row.get('evader_decision_ms')):>10}")
+    lines.append(f"grid sim: {report['sim_steps_per_s']:.0f} control steps/s")
+    lines.append(f"90 s games/s (enclosed, one core): R-R {fmt(report['rr_games_per_s'])}, "
+                 f"S-S {fmt(report['ss_games_per_s'])}")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    main()

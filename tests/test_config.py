@@ -1,0 +1,83 @@
+"""Every config option against the registry, and config validation errors."""
+
+from __future__ import annotations
+
+from importlib.resources import files
+from pathlib import Path
+
+import pytest
+from omegaconf import OmegaConf
+
+from pegame import registry
+from pegame.api import Camera
+from pegame.config import EnvConfig, GameConfig, resolve_map_path, typed
+from pegame.errors import ConfigError
+from pegame.maps import load_map
+
+CONF = Path(str(files("pegame.conf")))
+
+
+def options(group: str) -> list[str]:
+    return sorted(p.stem for p in (CONF / group).glob("*.yaml"))
+
+
+@pytest.mark.parametrize("group", list(registry.GROUPS))
+def test_every_option_matches_its_registry_entry(group, compose_config):
+    assert options(group), f"conf/{group}/ has no options"
+    assert set(options(group)) == set(registry.available(group))
+    for option in options(group):
+        cfg = compose_config([f"{group}={option}"])
+        assert cfg[group].name == option
+        cls = registry.load(group, option)
+        params = {k: v for k, v in cfg[group].items() if k != "name"}
+        registry.make_config(group, cls, params)  # the yaml is valid for the plugin
+
+
+@pytest.mark.parametrize("env", options("env"))
+def test_every_env_option_loads_its_map(env, compose_config):
+    cfg = compose_config([f"env={env}"])
+    settings = typed(cfg.env, EnvConfig, "env")
+    grid = load_map(resolve_map_path(settings.map))
+    assert settings.name == env == grid.name
+
+
+def test_default_config_validates(compose_config):
+    cfg = compose_config()
+    assert typed(cfg.game, GameConfig, "game").t_max == 90.0
+    assert typed(cfg.camera, Camera, "camera") == Camera()
+
+
+@pytest.mark.parametrize(
+    "node, key, params, message",
+    [
+        ("game", GameConfig, {"t_max": -1.0}, "'game.t_max'"),
+        ("game", GameConfig, {"control_hz": 0.0}, "'game.control_hz'"),
+        ("game", GameConfig, {"speed_ratio": -2.0}, "'game.speed_ratio'"),
+        ("game", GameConfig, {"decision_hz": 20.0}, "'game.decision_hz'"),
+        ("game", GameConfig, {"t_max": "abc"}, "'game.t_max'"),
+        ("game", GameConfig, {"t_maxx": 3}, "Unknown key 'game.t_maxx'. Allowed keys under 'game': seed, t_max"),
+        ("camera", Camera, {"fov": 7.0}, "'camera.fov'"),
+        ("camera", Camera, {"fov": 0.0}, "(0, 2*pi]"),
+        ("camera", Camera, {"far": 0.1}, "'camera.far'"),
+    ],
+)
+def test_bad_values_name_the_key_and_the_allowed_range(node, key, params, message):
+    with pytest.raises(ConfigError) as info:
+        typed(OmegaConf.create(params), key, node)
+    assert message in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "group, option, params, key",
+    [
+        ("evader", "random", {"v_max": 0.0}, "evader.v_max"),
+        ("evader", "random", {"radius": -0.1}, "evader.radius"),
+        ("pursuer", "random", {"w_max": 0.0}, "pursuer.w_max"),
+        ("pursuer", "random", {"speed": 1.0}, "pursuer.speed"),
+        ("detector", "oracle", {"miss_probability": 2.0}, "detector.miss_probability"),
+    ],
+)
+def test_plugin_config_errors_name_the_key(group, option, params, key):
+    cls = registry.load(group, option)
+    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
+        registry.make_config(group, cls, params)

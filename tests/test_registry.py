@@ -1,0 +1,86 @@
+"""Entry-point registries: lazy loading and the errors a user sees."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from importlib.metadata import EntryPoint
+
+import pytest
+
+from pegame import registry
+from pegame.api import INTERFACES
+
+
+@pytest.fixture
+def fake_points(monkeypatch):
+    """Replace the pursuer registry by hand-made entry points."""
+
+    def install(**values):
+        points = {name: EntryPoint(name, value, "pegame.pursuers") for name, value in values.items()}
+        monkeypatch.setattr(registry, "_entry_points", lambda group: points)
+
+    return install
+
+
+def test_builtins_are_registered_for_every_group():
+    for group in registry.GROUPS:
+        assert registry.available(group), group
+    assert {"random", "smart"} <= set(registry.available("pursuer"))
+    assert {"random", "smart"} <= set(registry.available("evader"))
+
+
+def test_every_builtin_loads_and_implements_its_interface():
+    for group in registry.GROUPS:
+        for name in registry.available(group):
+            cls = registry.load(group, name)
+            assert issubclass(cls, INTERFACES[group])
+            assert cls.description, f"{group} '{name}' has no description"
+
+
+def test_unknown_name_suggests_the_closest_and_lists_all():
+    with pytest.raises(registry.PluginError) as info:
+        registry.load("pursuer", "smrt")
+    assert str(info.value) == (
+        "Unknown pursuer 'smrt'. Did you mean 'smart'? Available: random, smart. "
+        "Plugins register under the entry-point group 'pegame.pursuers'."
+    )
+
+
+def test_import_failure_names_plugin_distribution_and_install_hint(fake_points):
+    fake_points(ghost="pegame_missing_dependency_xyz.module:Thing")
+    with pytest.raises(registry.PluginError) as info:
+        registry.load("pursuer", "ghost")
+    text = str(info.value)
+    assert "pursuer plugin 'ghost'" in text
+    assert "distribution" in text
+    assert "No module named 'pegame_missing_dependency_xyz'" in text
+    assert "pip install pegame_missing_dependency_xyz" in text
+
+
+def test_class_that_is_not_the_interface_is_a_type_error(fake_points):
+    fake_points(alien="fake_plugins:NotAPlugin", half="fake_plugins:HalfPursuer")
+    with pytest.raises(TypeError, match="must be a subclass of pegame.api.Pursuer"):
+        registry.load("pursuer", "alien")
+    with pytest.raises(TypeError, match="missing control, decide"):
+        registry.load("pursuer", "half")
+
+
+def test_import_pegame_loads_no_plugin():
+    code = (
+        "import sys, pegame, pegame.registry, pegame.api;"
+        "bad = [m for m in sys.modules if m.startswith(('pegame.sims', 'pegame.detectors',"
+        " 'pegame.estimators', 'pegame.pursuers', 'pegame.evaders', 'rerun', 'pybullet', 'cv2'))];"
+        "print(bad); sys.exit(1 if bad else 0)"
+    )
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
+def test_plugins_listing_shows_every_plugin_with_its_distribution():
+    out = subprocess.run(
+        [sys.executable, "-m", "pegame.plugins"], capture_output=True, text=True, check=True
+    ).stdout
+    for group, ep_group in registry.GROUPS.items():
+        assert f"{group} ({ep_group})" in out
+        for name in registry.available(group):
+            assert any(line.split()[:2] == [name, "pegame"] for line in out.splitlines()), name
