@@ -3,7 +3,9 @@
 :func:`visibility_region` implements the paper's Algorithm 1 ("Algorithm to compute
 visibility region"): rays leave the camera at angles theta + a for a from -fov/2 to +fov/2
 in steps of ``angle_step``, and each ray is sampled at distances 0, distance_step, ...,
-far; the cell of every sample at distance >= near joins the region V^p_k.
+far; the cell of every sample at distance >= near joins the region V^p_k. (The printed
+outer loop bound repeats theta_min; it is read as theta_max = +fov/2, and both the last
+ray at +fov/2 and the last sample at far are included.)
 
 Occlusion extension. Algorithm 1 as printed ignores obstacles, so a camera would see
 through walls. Here a ray stops at its first sample whose cell is blocked (occupied or
@@ -88,8 +90,10 @@ def visibility_region_reference(grid: OccupancyGrid, pose: Pose, camera: Camera)
 def _march(blocked, cos_a, sin_a, distances, first, px, py, ox, oy, c, s, rotate, res, mask):
     """Mark in ``mask`` the cells seen along each ray, stopping at the first blocked one.
 
-    Reproduces ``OccupancyGrid.world_to_cell`` operation for operation so that the result
-    matches :func:`visibility_region_reference` bit for bit.
+    Ray directions come precomputed by numpy, and ``OccupancyGrid.world_to_cell`` is
+    reproduced operation for operation (``c``, ``s``: cos and sin of the origin yaw,
+    applied when ``rotate``), so the result matches :func:`visibility_region_reference`
+    bit for bit.
     """
     height, width = blocked.shape
     for i in range(cos_a.size):

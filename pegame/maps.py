@@ -160,8 +160,6 @@ _SAVE_FORMATS = {"pgm": "PPM", "png": "PNG", "bmp": "BMP"}
 _PIXEL_MODES = ("1", "L", "LA", "P", "PA", "RGB", "RGBA")
 _DECODE_ERRORS = (OSError, ValueError, SyntaxError, EOFError, Image.DecompressionBombError)
 
-PathLike = str | os.PathLike
-
 
 @dataclass(frozen=True)
 class _MapSpec:
@@ -176,7 +174,7 @@ class _MapSpec:
     mode: str
 
 
-def load_map(yaml_path: PathLike) -> OccupancyGrid:
+def load_map(yaml_path: str | os.PathLike) -> OccupancyGrid:
     """Load a ROS map_server map (YAML plus image) as an OccupancyGrid.
 
     Semantics are in the module docstring. The grid's name is the YAML file's stem.
@@ -191,7 +189,7 @@ def load_map(yaml_path: PathLike) -> OccupancyGrid:
     return OccupancyGrid(data, spec.resolution, spec.origin, name=path.stem)
 
 
-def save_map(grid: OccupancyGrid, yaml_path: PathLike, image_format: str = "pgm") -> None:
+def save_map(grid: OccupancyGrid, yaml_path: str | os.PathLike, image_format: str = "pgm") -> None:
     """Write ``grid`` as a trinary ROS map: the image, then the YAML at ``yaml_path``.
 
     The image is ``<yaml stem>.<image_format>`` (pgm = binary P5, png or bmp) next to the
@@ -224,8 +222,15 @@ def save_map(grid: OccupancyGrid, yaml_path: PathLike, image_format: str = "pgm"
         "mode": "trinary",
     }
     text = yaml.safe_dump(meta, sort_keys=False, default_flow_style=None)
-    _write_atomically(image_path, lambda f: image.save(f, format=pillow_format))
-    _write_atomically(yaml_path, lambda f: f.write(text.encode("utf-8")))
+    writers = (
+        (image_path, lambda f: image.save(f, format=pillow_format)),
+        (yaml_path, lambda f: f.write(text.encode("utf-8"))),
+    )
+    for path, write in writers:
+        try:
+            _write_atomically(path, write)
+        except OSError as exc:
+            raise _fail(yaml_path, f"cannot write {path} ({exc.strerror or exc}).") from exc
 
 
 def _fail(path: Path, problem: str) -> MapError:
@@ -311,7 +316,7 @@ def _read_image(image_path: Path, yaml_path: Path) -> tuple[np.ndarray, np.ndarr
     Rows are in image order (row 0 = top).
     """
     if not image_path.is_file():
-        raise _fail(yaml_path, f"image file {image_path} does not exist.")
+        raise _fail(yaml_path, f"image file {image_path} does not exist or is not a file.")
     try:
         image = Image.open(image_path)
     except _DECODE_ERRORS as exc:
@@ -383,13 +388,6 @@ def _check_saveable(grid: OccupancyGrid, yaml_path: Path) -> None:
 
 def _write_atomically(path: Path, write: Callable[[IO[bytes]], Any]) -> None:
     """Write via a temporary file in the same directory, then os.replace it onto ``path``."""
-    try:
-        _replace_via_temp(path, write)
-    except OSError as exc:
-        raise _fail(path, f"cannot be written ({exc}).") from exc
-
-
-def _replace_via_temp(path: Path, write: Callable[[IO[bytes]], Any]) -> None:
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as f:

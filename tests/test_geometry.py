@@ -1,0 +1,283 @@
+"""Tests for pegame.geometry: Algorithm 1's visibility region with occlusion, line of sight."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.ndimage import binary_dilation
+
+from pegame.api import Camera, Pose
+from pegame.geometry import (
+    _ray_tables,
+    fov_wedge,
+    in_view,
+    line_of_sight,
+    visibility_region,
+    visibility_region_reference,
+)
+from pegame.maps import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+
+CAMERA = Camera(fov=math.pi / 3, near=0.3, far=3.0, angle_step=0.0016, distance_step=0.05)
+BOTH = [visibility_region, visibility_region_reference]
+
+
+def empty_grid(height=80, width=80, resolution=0.1, origin=(0.0, 0.0, 0.0)):
+    return OccupancyGrid(np.full((height, width), FREE, dtype=np.int8), resolution, origin)
+
+
+def random_grid(rng, height, width, resolution, origin=(0.0, 0.0, 0.0), density=0.1):
+    """Free cells with a sprinkle of occupied and unknown ones."""
+    data = np.full((height, width), FREE, dtype=np.int8)
+    data[rng.random((height, width)) < density] = OCCUPIED
+    data[rng.random((height, width)) < density / 5] = UNKNOWN
+    return OccupancyGrid(data, resolution, origin)
+
+
+def random_free_pose(rng, grid):
+    """A pose at a random point of a random free cell, random heading."""
+    rows, cols = np.nonzero(grid.free)
+    k = rng.integers(rows.size)
+    x, y = grid.cell_to_world(rows[k], cols[k])
+    jitter = rng.uniform(-0.45, 0.45, 2) * grid.resolution
+    return Pose(x + jitter[0], y + jitter[1], rng.uniform(-math.pi, math.pi))
+
+
+def random_camera(rng):
+    return Camera(
+        fov=rng.uniform(0.3, 2 * math.pi),
+        near=rng.uniform(0.0, 0.8),
+        far=rng.uniform(1.0, 4.0),
+        angle_step=rng.uniform(0.004, 0.03),
+        distance_step=rng.uniform(0.02, 0.15),
+    )
+
+
+def polar(grid, pose, rows, cols):
+    """Range (m) and bearing from the optical axis (rad) of the given cells' centres."""
+    x, y = grid.cell_to_world(rows, cols)
+    dx, dy = np.asarray(x) - pose.x, np.asarray(y) - pose.y
+    angle = np.arctan2(dy, dx) - pose.theta
+    bearing = np.arctan2(np.sin(angle), np.cos(angle))
+    return np.hypot(dx, dy), bearing
+
+
+# ----------------------------------------------------------------------- ray tables
+
+
+def test_ray_tables_span_fov_and_range_inclusively():
+    angles, distances, first = _ray_tables(CAMERA)
+    assert angles[0] == -CAMERA.fov / 2 and angles[-1] == CAMERA.fov / 2
+    assert np.all(np.diff(angles) > 0) and np.all(np.diff(angles) <= CAMERA.angle_step + 1e-12)
+    assert distances[0] == 0.0 and distances[-1] == CAMERA.far
+    assert np.all(np.diff(distances) > 0)
+    assert np.all(np.diff(distances) <= CAMERA.distance_step + 1e-12)
+    assert distances[first] >= CAMERA.near > distances[first - 1]
+
+
+# ----------------------------------------------------------------- visibility region
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_visible_cells_lie_in_the_wedge_and_range(seed):
+    rng = np.random.default_rng(seed)
+    grid = random_grid(rng, 60, 70, 0.1, origin=(rng.uniform(-2, 2), rng.uniform(-2, 2), 0.0))
+    for _ in range(10):
+        camera, pose = random_camera(rng), random_free_pose(rng, grid)
+        mask = visibility_region(grid, pose, camera)
+        rows, cols = np.nonzero(mask)
+        assert not np.any(grid.blocked[rows, cols])
+        dist, bearing = polar(grid, pose, rows, cols)
+        res = grid.resolution
+        assert np.all((dist >= camera.near - res) & (dist <= camera.far + res))
+        far_enough = dist > res
+        tolerance = np.arctan(res / dist[far_enough])
+        assert np.all(np.abs(bearing[far_enough]) <= camera.fov / 2 + tolerance)
+
+
+@pytest.mark.parametrize("region", BOTH)
+def test_wall_across_the_fov_hides_the_cells_behind_it(region):
+    data = np.full((80, 80), FREE, dtype=np.int8)
+    data[:, 40] = OCCUPIED  # the wall x in [4.0, 4.1) m
+    grid = OccupancyGrid(data, 0.1)
+    mask = region(grid, Pose(2.0, 4.0, 0.0), CAMERA)
+    assert not mask[:, 40:].any()
+    assert mask[35:45, 39].all()  # the free cells in front of the wall are seen
+
+
+@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-3.2, 1.7, 0.0), (1.0, -2.0, 0.6)])
+def test_empty_map_sees_the_whole_wedge_interior(origin):
+    grid = empty_grid(origin=origin)
+    cx, cy = grid.cell_to_world(40, 20)
+    pose = Pose(cx + 0.013, cy - 0.021, origin[2] + 0.2)
+    mask = visibility_region(grid, pose, CAMERA)
+    rows, cols = np.indices(mask.shape)
+    dist, bearing = polar(grid, pose, rows, cols)
+    res = grid.resolution
+    interior = (
+        (dist >= CAMERA.near + res)
+        & (dist <= CAMERA.far - res)
+        & (np.abs(bearing) <= CAMERA.fov / 2 - 1e-3)
+    )
+    assert interior.sum() > 300
+    assert mask[interior].all()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_fast_mask_equals_reference_mask(seed):
+    rng = np.random.default_rng(100 + seed)
+    height, width = rng.integers(10, 60, 2)
+    resolution = float(rng.choice([0.05, 0.1, 0.25]))
+    yaw = 0.0 if seed % 2 else float(rng.uniform(-math.pi, math.pi))
+    origin = (rng.uniform(-5, 5), rng.uniform(-5, 5), yaw)
+    grid = random_grid(rng, height, width, resolution, origin, density=rng.uniform(0.0, 0.3))
+    for _ in range(25):
+        camera, pose = random_camera(rng), random_free_pose(rng, grid)
+        fast = visibility_region(grid, pose, camera)
+        assert np.array_equal(fast, visibility_region_reference(grid, pose, camera))
+
+
+@pytest.mark.parametrize("region", BOTH)
+def test_camera_in_a_blocked_cell_or_off_the_map_sees_nothing(region):
+    data = np.full((40, 40), FREE, dtype=np.int8)
+    data[20, 20] = OCCUPIED
+    data[10, 10] = UNKNOWN
+    grid = OccupancyGrid(data, 0.1)
+    for x, y in [(2.05, 2.05), (1.05, 1.05), (-1.0, 2.0)]:
+        mask = region(grid, Pose(x, y, 0.3), CAMERA)
+        assert mask.shape == grid.blocked.shape and not mask.any()
+
+
+# --------------------------------------------------------------------- line of sight
+
+
+def test_line_of_sight_is_symmetric_on_a_random_grid():
+    rng = np.random.default_rng(7)
+    grid = random_grid(rng, 40, 40, 0.1, origin=(0.5, -0.5, 0.3), density=0.05)
+    for _ in range(200):
+        a, b = random_free_pose(rng, grid), random_free_pose(rng, grid)
+        assert line_of_sight(grid, a.xy, b.xy) == line_of_sight(grid, b.xy, a.xy)
+
+
+def test_line_of_sight_is_broken_by_a_wall_and_blocked_endpoints():
+    data = np.full((40, 40), FREE, dtype=np.int8)
+    data[:, 20] = OCCUPIED  # x in [2.0, 2.1) m
+    grid = OccupancyGrid(data, 0.1)
+    assert line_of_sight(grid, (0.5, 1.0), (1.9, 3.5))
+    assert not line_of_sight(grid, (0.5, 1.0), (3.5, 3.0))
+    assert not line_of_sight(grid, (3.5, 3.0), (0.5, 1.0))
+    assert not line_of_sight(grid, (0.5, 1.0), (2.05, 1.0))
+    assert not line_of_sight(grid, (0.5, 1.0), (-0.5, 1.0))
+    assert line_of_sight(grid, (0.5, 1.0), (0.5, 1.0))
+
+
+# --------------------------------------------------------------------------- in view
+
+
+def dilated(grid):
+    """``grid`` with every blocked cell grown by two cells in each direction."""
+    grown = binary_dilation(grid.blocked, np.ones((5, 5), dtype=bool))
+    return OccupancyGrid(np.where(grown, OCCUPIED, FREE), grid.resolution, grid.origin)
+
+
+def occlusion_class(grid, grown, pose, row, col):
+    """How the blocked cells of ``grid`` (origin yaw 0) affect cell (row, col) seen from ``pose``.
+
+    "clear": the segment to the cell centre stays at least one cell away from every blocked
+    cell (line of sight on ``grown = dilated(grid)``). "hidden": every ray through the cell
+    crosses a blocked cell well inside it (0.35 cells from its sides) at least 1.5 cells
+    before the centre's range. None otherwise: a shadow edge, where sampled visibility may
+    go either way.
+    """
+    centre = grid.cell_to_world(row, col)
+    if line_of_sight(grown, pose.xy, centre, step=grid.resolution / 4):
+        return "clear"
+    camera = (pose.xy - grid.origin[:2]) / grid.resolution  # cell units, (x, y)
+    reach = np.hypot(col + 0.5 - camera[0], row + 0.5 - camera[1]) - 1.5
+    t = np.linspace(0.0, 1.0, int(reach * 10) + 2)[:, None]
+    for u in np.linspace(0.0, 1.0, 5):
+        for v in np.linspace(0.0, 1.0, 5):
+            target = np.array([col + u, row + v])
+            points = camera + t * (target - camera) / np.hypot(*(target - camera)) * reach
+            cells = np.floor(points).astype(int)
+            frac = points - cells
+            deep = np.all((frac >= 0.35) & (frac <= 0.65), axis=1)
+            if not np.any(deep & grid.blocked[cells[:, 1], cells[:, 0]]):
+                return None
+    return "hidden"
+
+
+def pose_facing_a_block(rng, grid):
+    """A free pose 1 to 2 m from a random blocked cell, heading roughly towards it."""
+    rows, cols = np.nonzero(grid.blocked)
+    while True:
+        k = rng.integers(rows.size)
+        target = np.array(grid.cell_to_world(rows[k], cols[k]))
+        heading = rng.uniform(-math.pi, math.pi)
+        x, y = target - rng.uniform(1.0, 2.0) * np.array([math.cos(heading), math.sin(heading)])
+        if grid.is_free(x, y):
+            return Pose(x, y, heading + rng.uniform(-0.3, 0.3))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_in_view_agrees_with_the_mask_away_from_wedge_and_shadow_edges(seed):
+    rng = np.random.default_rng(200 + seed)
+    data = np.full((60, 60), FREE, dtype=np.int8)
+    for _ in range(5):  # a few rectangular blocks
+        r, c = rng.integers(5, 50, 2)
+        data[r : r + rng.integers(2, 8), c : c + rng.integers(2, 8)] = OCCUPIED
+    grid = OccupancyGrid(data, 0.1, origin=(1.0, 2.0, 0.0))
+    grown = dilated(grid)
+    margin = 2 * grid.resolution
+    counts = {"clear": 0, "hidden": 0}
+    for _ in range(4):
+        pose = pose_facing_a_block(rng, grid)
+        mask = visibility_region(grid, pose, CAMERA)
+        rows, cols = np.nonzero(grid.free)
+        dist, bearing = polar(grid, pose, rows, cols)
+        excess = np.abs(bearing) - CAMERA.fov / 2  # angle beyond the wedge edge, rad
+        edge_gap = dist * np.sin(np.minimum(-excess, math.pi / 2))
+        outside_gap = dist * np.sin(np.minimum(excess, math.pi / 2))
+        inside = (dist > CAMERA.near + margin) & (dist < CAMERA.far - margin) & (edge_gap > margin)
+        outside = (dist > CAMERA.far + margin) | (outside_gap > margin)
+        for r, c in zip(rows[outside], cols[outside]):
+            assert not mask[r, c] and not in_view(grid, CAMERA, pose, grid.cell_to_world(r, c))
+        for r, c in zip(rows[inside], cols[inside]):
+            kind = occlusion_class(grid, grown, pose, r, c)
+            if kind is not None:
+                counts[kind] += 1
+                expected = kind == "clear"
+                assert mask[r, c] == expected, (r, c, kind)
+                assert in_view(grid, CAMERA, pose, grid.cell_to_world(r, c)) == expected
+    assert counts["clear"] > 100 and counts["hidden"] > 10, counts
+
+
+def test_in_view_checks_bearing_range_and_occlusion():
+    data = np.full((40, 40), FREE, dtype=np.int8)
+    data[15:25, 30] = OCCUPIED  # x in [3.0, 3.1) m
+    grid = OccupancyGrid(data, 0.1)
+    pose = Pose(1.0, 2.0, 0.0)
+    assert in_view(grid, CAMERA, pose, (2.5, 2.0))
+    assert not in_view(grid, CAMERA, pose, (3.5, 2.0))  # behind the wall
+    assert not in_view(grid, CAMERA, pose, (1.1, 2.0))  # closer than near
+    assert not in_view(grid, CAMERA, pose, (1.0, 3.5))  # outside the fov
+    assert not in_view(grid, CAMERA, Pose(0.5, 0.2, 0.0), (3.8, 0.2))  # beyond far
+
+
+# -------------------------------------------------------------------------- fov wedge
+
+
+@pytest.mark.parametrize("near", [0.0, 0.3])
+def test_fov_wedge_is_a_closed_ring_on_the_range_limits(near):
+    camera = Camera(fov=1.2, near=near, far=2.5)
+    pose = Pose(1.0, -2.0, 0.7)
+    ring = fov_wedge(camera, pose, n=16)
+    assert ring.shape == ((16 if near else 1) + 16 + 1, 2)
+    assert np.array_equal(ring[0], ring[-1])
+    d = ring - pose.xy
+    dist = np.hypot(d[:, 0], d[:, 1])
+    assert np.allclose(dist[-17:-1], camera.far)
+    assert np.allclose(dist[: 16 if near else 1], near)
+    bearing = np.arctan2(d[-17:-1, 1], d[-17:-1, 0]) - pose.theta
+    assert np.allclose([bearing.min(), bearing.max()], [-0.6, 0.6])
