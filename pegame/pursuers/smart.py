@@ -1,0 +1,173 @@
+"""The paper's smart pursuer (paper, Sec. "Smart Pursuer"): a hybrid of a reactive
+visual controller while the evader is detected and navigation to the estimator's
+estimate while it is not.
+
+Tracking (a detection this control tick): the evader is kept in the centre of the image
+and at ``standoff`` metres. The paper's image offset of the bounding box,
+
+    target_offset_x = x_b + w_b / 2 - w_I / 2        (pixels),
+
+with (x_b, y_b, w_b, h_b) the box (top-left corner and size, px) and w_I the image width
+(px), is normalised by w_I to u in [-1/2, 1/2] (positive: evader right of the optical
+axis) and turned into a turn rate w = -k_w * u (rad/s, map frame CCW positive, so an
+evader on the right makes the robot turn clockwise). The forward speed follows the
+detection's depth (m, along the optical axis): v = k_v * (depth - standoff) (m/s), so
+the robot approaches a far evader and backs off from a near one. Both are saturated to
+the body's limits, and v is set to 0 when the straight motion over a short look-ahead
+would enter the pursuer's inflated obstacle cells (``inflate(grid, radius)``, the
+simulator's collision mask of the robot's centre).
+
+Searching (no detection): the pursuer plans from its pose to the estimator's estimate,
+the weighted mean of the particles (``observation.belief.mean``, map frame, m), and
+follows the path; it replans at every decision and at once when it loses the evader.
+Once there, or when there is no reachable estimate, it rotates in place to scan for
+the evader. A detection switches back to tracking at the next control tick.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pegame.api import Plan, Pose, Pursuer, PursuerObservation, Velocity, wrap_angle
+from pegame.errors import require
+from pegame.navigation import PathFollower, Planner, inflate
+
+log = logging.getLogger(__name__)
+
+#: s; the collision check looks this far ahead at the commanded speed (at least one radius)
+LOOKAHEAD_TIME = 0.5
+
+TRACK, SEARCH, SCAN = "track", "search", "scan"
+
+
+class SmartPursuer(Pursuer):
+    """Centres the detected evader at a standoff distance; when it is lost, drives to the
+    estimator's estimate and scans there."""
+
+    description = "Paper's hybrid: centres the seen evader at a standoff, else goes to the estimate."
+
+    @dataclass
+    class Config(Pursuer.Config):
+        standoff: float = 1.5  # m, distance to keep from the evader along the optical axis
+        k_w: float = 4.0  # rad/s per unit of image offset (box centre offset / image width)
+        k_v: float = 1.0  # 1/s, forward speed per metre of depth error (depth - standoff)
+        scan_rate: float = 1.0  # rad/s, turn rate when scanning in place
+
+        def __post_init__(self) -> None:
+            super().__post_init__()
+            require(self.standoff > 0, "pursuer.standoff", "a positive distance in m", self.standoff)
+            require(self.k_w > 0, "pursuer.k_w", "a positive gain in rad/s", self.k_w)
+            require(self.k_v > 0, "pursuer.k_v", "a positive gain in 1/s", self.k_v)
+            require(self.scan_rate > 0, "pursuer.scan_rate", "a positive turn rate in rad/s", self.scan_rate)
+
+    def __init__(self, config, context, rng) -> None:
+        super().__init__(config, context, rng)
+        self.planner = Planner(context.grid, context.pursuer.radius)
+        self.follower = PathFollower(context.pursuer)
+        self.blocked = inflate(context.grid, context.pursuer.radius)
+        self.reset(Pose(0.0, 0.0))
+
+    def reset(self, pose: Pose) -> None:
+        # The game starts with the evader in view, so the pursuer starts out tracking.
+        self.mode = TRACK
+        self._scan_sign = 1.0  # +1 CCW, -1 CW
+        self.follower.set_path(np.zeros((0, 2)))
+
+    def decide(self, observation: PursuerObservation) -> Plan:
+        """Track a detected evader; otherwise replan to the current estimate."""
+        if observation.detection is not None:
+            self.mode = TRACK
+            return Plan(goal=observation.detection.position, info={"mode": TRACK})
+        return self._search(observation)
+
+    def control(self, observation: PursuerObservation) -> Velocity:
+        """The reactive command while the evader is detected; else follow the path to the
+        estimate, then scan in place."""
+        if observation.detection is not None:
+            self.mode = TRACK
+            return self._track(observation)
+        if self.mode == TRACK:
+            # Just lost the evader: head for the estimate now rather than at the next decision.
+            self._search(observation)
+        if self.mode == SEARCH:
+            command = self.follower.command(observation.pose)
+            if not self.follower.done:
+                return command
+            self._start_scan(observation)
+        return Velocity(0.0, self._scan_sign * self.config.scan_rate)
+
+    # -- tracking
+
+    def _track(self, observation: PursuerObservation) -> Velocity:
+        """The paper's reactive controller on this tick's detection, made collision-safe."""
+        detection, body = observation.detection, self.context.pursuer
+        width = self.context.camera.image_width
+        offset = (detection.box.x + 0.5 * detection.box.w - 0.5 * width) / width
+        w = _clamp(-self.config.k_w * offset, body.w_max)
+        v = _clamp(self.config.k_v * (detection.depth - self.config.standoff), body.v_max)
+        reach = math.copysign(max(abs(v) * LOOKAHEAD_TIME, body.radius), v)
+        if v != 0.0 and not self._clear(observation.pose, reach):
+            v = 0.0
+        return Velocity(v, w)
+
+    def _clear(self, pose: Pose, distance: float) -> bool:
+        """True when moving ``distance`` m straight along the heading (negative: backwards)
+        from ``pose`` stays on the grid and out of inflated obstacle cells.
+
+        Samples are half a cell apart so no thin wall is skipped. The cell the robot is in
+        does not count: a robot whose centre already touches the inflation zone (possible in
+        a continuous simulator) must still be able to move out of it.
+        """
+        grid = self.context.grid
+        n = max(1, math.ceil(2 * abs(distance) / grid.resolution))
+        s = np.linspace(distance / n, distance, n)
+        rows, cols = grid.world_to_cell(pose.x + s * math.cos(pose.theta), pose.y + s * math.sin(pose.theta))
+        if not grid.contains(rows, cols).all():
+            return False
+        here = grid.world_to_cell(pose.x, pose.y)
+        elsewhere = (rows != here[0]) | (cols != here[1])
+        return not self.blocked[rows[elsewhere], cols[elsewhere]].any()
+
+    # -- searching
+
+    def _search(self, observation: PursuerObservation) -> Plan:
+        """Plan to the estimate and follow it (mode SEARCH), or scan when there is none."""
+        pose, estimate = observation.pose, observation.belief.mean
+        if estimate is None:
+            log.info("t=%.1f s: no estimate of the evader; scanning in place", observation.time)
+            self._start_scan(observation)
+            return Plan(info={"mode": SCAN, "reason": "no estimate"})
+        result = self.planner.plan((pose.x, pose.y), estimate)
+        if not result.reachable:
+            log.info(
+                "t=%.1f s: estimate (%.2f, %.2f) m is unreachable (%s); scanning in place",
+                observation.time, estimate[0], estimate[1], result.reason,
+            )
+            self._start_scan(observation)
+            return Plan(info={"mode": SCAN, "reason": result.reason})
+        self.mode = SEARCH
+        self.follower.set_path(result.path)
+        return Plan(goal=(float(estimate[0]), float(estimate[1])), path=result.path, info={"mode": SEARCH})
+
+    def _start_scan(self, observation: PursuerObservation) -> None:
+        """Scan in place, turning toward the estimate when it lies outside the camera's
+        field of view; otherwise keep the previous direction so the scan does not dither."""
+        self.mode = SCAN
+        self.follower.set_path(np.zeros((0, 2)))
+        estimate, pose = observation.belief.mean, observation.pose
+        if estimate is None:
+            return
+        dx, dy = estimate[0] - pose.x, estimate[1] - pose.y
+        if math.hypot(dx, dy) <= self.follower.goal_tolerance:
+            return  # standing on the estimate: its bearing means nothing
+        bearing = wrap_angle(math.atan2(dy, dx) - pose.theta)
+        if abs(bearing) > 0.5 * self.context.camera.fov:
+            self._scan_sign = math.copysign(1.0, bearing)
+
+
+def _clamp(value: float, limit: float) -> float:
+    return max(-limit, min(limit, value))
