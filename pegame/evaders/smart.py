@@ -1,0 +1,184 @@
+"""The paper's smart evader (Sec. "Smart Evader", Algorithms 1 and 2).
+
+At every decision the evader is told the pursuer's pose (the paper's assumption) and:
+
+1. computes the pursuer's visibility region V (Algorithm 1, with occlusion:
+   :func:`pegame.geometry.visibility_region` for ``context.camera``);
+2. takes as candidate goals the cells of F \\ V it can reach: traversable for its radius
+   and connected to its own cell (:meth:`pegame.navigation.Planner.reachable`), minus V;
+3. scores each candidate i with Algorithm 2's
+   ``cost_escape[i] = cost_effort[i] / cost_dist[i]``, where cost_effort is the distance
+   (m) from the evader to the candidate and cost_dist the distance (m) from the pursuer to
+   it; a candidate at distance 0 from the pursuer costs +inf (no division by zero);
+4. navigates to the argmin: :meth:`Planner.plan` for the path, :class:`PathFollower`
+   for the (v, w) commands at control ticks.
+
+Distances (``Config.distance``): ``euclidean`` is the paper's straight-line distance
+between the agents' positions and the candidate cell centres; ``geodesic`` is the
+shortest 8-connected path on the grid (:meth:`Planner.distance_field`, unweighted), the
+evader's over the cells traversable for its radius and the pursuer's over the cells
+traversable for the pursuer's radius (``context.pursuer.radius``). A candidate the
+pursuer cannot reach has cost_dist = +inf and so cost 0: an ideal hiding place.
+
+Ties go to the lowest cost, then to the lowest row-major cell index (row * width + col),
+so the same inputs always give the same goal.
+
+An evader already out of sight stays put. cost_effort, and cost_escape with it, is
+smallest at the evader's own position, so whenever the evader's own cell is outside V the
+argmin is at or next to that cell (with euclidean distances the cell centres sit up to
+half a cell from the evader): the evader waits where it is until V reaches it and only
+then runs. That is Algorithm 2 as printed, kept on purpose. With geodesic distances the
+own cell costs exactly 0 and ties with every cell the pursuer cannot reach; a tied cell
+of lower row-major index then wins, so the evader moves into such a region.
+
+When no candidate exists (V covers all the free space the evader can reach) the evader
+logs it at INFO and keeps following its current plan (it stands still when it has none).
+
+Cost control: V and the argmin are recomputed at every decision, but the path is
+replanned only when the chosen goal moves by more than one cell (Chebyshev distance) from
+the goal being followed. ``candidate_stride`` k > 1 scores only the cells whose row and
+column are both multiples of k (about 1/k^2 of them).
+
+Units and frames: metres, seconds and radians in the map frame of :mod:`pegame.maps`
+(x right, y up, row 0 = lowest y). Candidates are cell centres.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pegame.api import STOP, Evader, EvaderObservation, Plan, Pose, Velocity
+from pegame.errors import require
+from pegame.geometry import visibility_region
+from pegame.navigation import PathFollower, Planner
+
+log = logging.getLogger(__name__)
+
+DISTANCES = ("euclidean", "geodesic")
+
+#: most candidate points put into Plan.info["candidates"] for the recorder
+MAX_RECORDED_CANDIDATES = 2000
+
+
+def escape_costs(effort: np.ndarray, dist: np.ndarray) -> np.ndarray:
+    """Algorithm 2's cost effort / dist per candidate (both in m, same shape).
+
+    A candidate at dist 0 (under the pursuer) costs +inf; dist +inf (out of the pursuer's
+    reach) with a finite effort costs 0.
+    """
+    cost = np.full(effort.shape, np.inf)
+    np.divide(effort, dist, out=cost, where=dist > 0)
+    return cost
+
+
+def subsample(points: np.ndarray, limit: int) -> np.ndarray:
+    """At most ``limit`` rows of ``points`` (K, 2), evenly spaced in their order."""
+    step = max(1, math.ceil(len(points) / limit))
+    return points[::step]
+
+
+class SmartEvader(Evader):
+    """Runs to the reachable cell outside the pursuer's view minimising effort / distance."""
+
+    description = "Paper's smart evader: escapes to the out-of-view cell minimising effort/distance."
+
+    @dataclass
+    class Config(Evader.Config):
+        distance: str = "euclidean"  # 'euclidean' (the paper) or 'geodesic' (grid paths)
+        candidate_stride: int = 1  # score every k-th cell in rows and columns (k >= 1)
+
+        def __post_init__(self) -> None:
+            super().__post_init__()
+            require(self.distance in DISTANCES, "evader.distance", ", ".join(DISTANCES), self.distance)
+            require(
+                self.candidate_stride >= 1, "evader.candidate_stride", "an integer >= 1",
+                self.candidate_stride,
+            )
+
+    def __init__(self, config, context, rng) -> None:
+        super().__init__(config, context, rng)
+        grid = context.grid
+        self.planner = Planner(grid, context.evader.radius)
+        # The pursuer's planner only serves its geodesic distance field.
+        self.pursuer_planner = (
+            Planner(grid, context.pursuer.radius) if config.distance == "geodesic" else None
+        )
+        self.follower = PathFollower(context.evader)
+        rows, cols = np.indices(grid.data.shape)
+        # Cell centres (m, map frame) by flat row-major cell index, shape (H * W, 2).
+        self._centres = np.column_stack([v.ravel() for v in grid.cell_to_world(rows, cols)])
+        stride = config.candidate_stride
+        self._strided = (rows % stride == 0) & (cols % stride == 0)
+        self.plan = Plan()
+        self._goal_cell: tuple[int, int] | None = None
+
+    def reset(self, pose: Pose) -> None:
+        self.plan, self._goal_cell = Plan(), None
+        self.follower.set_path(np.zeros((0, 2)))
+
+    def decide(self, observation: EvaderObservation) -> Plan:
+        """Recompute V and the escape goal; replan when the goal moved by more than a cell.
+
+        The returned plan's goal and path are those being followed; its info holds
+        "candidates", float (K, 2) candidate cell centres (m, map frame, at most
+        MAX_RECORDED_CANDIDATES of them, evenly subsampled), and "escape_cost", the cost of
+        this decision's argmin (+inf when there is no candidate).
+        """
+        me, pursuer = observation.pose, observation.pursuer
+        cells = self.candidates(me, pursuer)
+        if cells.size == 0:
+            log.info(
+                "t=%.2f s: the pursuer's view covers all free space the evader can reach; "
+                "keeping the current plan.", observation.time,
+            )
+            self.plan = Plan(self.plan.goal, self.plan.path,
+                             {"candidates": np.zeros((0, 2)), "escape_cost": math.inf})
+            return self.plan
+        cost = self.costs(me, pursuer, cells)
+        best = int(np.argmin(cost))  # first minimum = lowest row-major index among ties
+        cell = divmod(int(cells[best]), self.context.grid.width)
+        goal, path = self.plan.goal, self.plan.path
+        if self._needs_replan(cell):
+            goal = tuple(float(v) for v in self._centres[cells[best]])
+            path = self.planner.plan((me.x, me.y), goal).path
+            self.follower.set_path(path)
+            self._goal_cell = cell
+        info = {
+            "candidates": subsample(self._centres[cells], MAX_RECORDED_CANDIDATES),
+            "escape_cost": float(cost[best]),
+        }
+        self.plan = Plan(goal, path, info)
+        return self.plan
+
+    def control(self, observation: EvaderObservation) -> Velocity:
+        return self.follower.command(observation.pose) if self.plan.goal is not None else STOP
+
+    def candidates(self, me: Pose, pursuer: Pose) -> np.ndarray:
+        """Flat row-major indices (row * width + col, increasing) of the candidate cells:
+        reachable by the evader at ``me``, outside the visibility region of the pursuer at
+        ``pursuer``, and on the candidate stride."""
+        visible = visibility_region(self.context.grid, pursuer, self.context.camera)
+        mask = self.planner.reachable((me.x, me.y)) & ~visible & self._strided
+        return np.flatnonzero(mask)
+
+    def costs(self, me: Pose, pursuer: Pose, cells: np.ndarray) -> np.ndarray:
+        """Algorithm 2's cost_escape (dimensionless) of the flat-indexed candidate ``cells``."""
+        if self.config.distance == "euclidean":
+            x, y = self._centres[cells].T
+            effort = np.sqrt((x - me.x) ** 2 + (y - me.y) ** 2)
+            dist = np.sqrt((x - pursuer.x) ** 2 + (y - pursuer.y) ** 2)
+        else:
+            effort = self.planner.distance_field((me.x, me.y)).ravel()[cells]
+            dist = self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()[cells]
+        return escape_costs(effort, dist)
+
+    def _needs_replan(self, cell: tuple[int, int]) -> bool:
+        """True when there is no path to follow or ``cell`` is more than one cell (Chebyshev)
+        from the goal being followed."""
+        if self._goal_cell is None or len(self.follower.path) == 0:
+            return True
+        return max(abs(cell[0] - self._goal_cell[0]), abs(cell[1] - self._goal_cell[1])) > 1

@@ -1,0 +1,298 @@
+"""Tests for pegame.evaders.smart: the paper's smart evader (Algorithm 2 on top of Alg. 1)."""
+
+from __future__ import annotations
+
+import heapq
+import logging
+import math
+from collections import deque
+
+import numpy as np
+import pytest
+
+from pegame.api import Body, Camera, Context, EvaderObservation, Pose
+from pegame.errors import ConfigError
+from pegame.evaders.smart import MAX_RECORDED_CANDIDATES, SmartEvader
+from pegame.geometry import visibility_region
+from pegame.maps import FREE, OCCUPIED, OccupancyGrid
+from pegame.navigation import Planner
+from pegame.registry import make_config
+
+RES = 0.1  # m per cell in every test grid
+CAMERA = Camera(fov=math.pi / 3, near=0.3, far=5.0, angle_step=0.004, distance_step=0.05)
+EVADER = Body(radius=0.12, v_max=0.5, w_max=1.8)
+PURSUER = Body(radius=0.08, v_max=0.5, w_max=1.8)
+
+
+def walled_grid(height: int, width: int, blocks=()) -> OccupancyGrid:
+    """A free grid of RES-metre cells with a one-cell outer wall and occupied blocks given
+    as (row0, row1, col0, col1) half-open index ranges."""
+    data = np.full((height, width), FREE, dtype=np.int8)
+    data[[0, -1], :] = OCCUPIED
+    data[:, [0, -1]] = OCCUPIED
+    for r0, r1, c0, c1 in blocks:
+        data[r0:r1, c0:c1] = OCCUPIED
+    return OccupancyGrid(data, RES)
+
+
+def make_evader(grid, distance="euclidean", camera=CAMERA, evader=EVADER, pursuer=PURSUER, **params):
+    config = make_config(
+        "evader",
+        SmartEvader,
+        {"radius": evader.radius, "v_max": evader.v_max, "w_max": evader.w_max,
+         "distance": distance, **params},
+    )
+    context = Context(grid, pursuer, evader, camera, control_dt=0.1, decision_dt=1.0)
+    smart = SmartEvader(config, context, np.random.default_rng(0))
+    return smart
+
+
+def centre(row: int, col: int) -> tuple[float, float]:
+    """Centre (m) of cell (row, col) of a test grid (origin 0, yaw 0)."""
+    return (col + 0.5) * RES, (row + 0.5) * RES
+
+
+def cell_of(xy) -> tuple[int, int]:
+    return int(math.floor(xy[1] / RES)), int(math.floor(xy[0] / RES))
+
+
+# ------------------------------------------------------------------ brute-force reference
+
+
+def bfs_reachable(traversable: np.ndarray, start: tuple[int, int]) -> np.ndarray:
+    """4-connected flood fill of ``traversable`` from ``start``."""
+    seen = np.zeros_like(traversable)
+    seen[start] = True
+    queue = deque([start])
+    while queue:
+        r, c = queue.popleft()
+        for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+            nr, nc = r + dr, c + dc
+            if 0 <= nr < seen.shape[0] and 0 <= nc < seen.shape[1]:
+                if traversable[nr, nc] and not seen[nr, nc]:
+                    seen[nr, nc] = True
+                    queue.append((nr, nc))
+    return seen
+
+
+def dijkstra(traversable: np.ndarray, start: tuple[int, int]) -> np.ndarray:
+    """Geodesic distance (m) over 8-connected moves without corner cutting; inf if unreachable."""
+    height, width = traversable.shape
+    dist = np.full(traversable.shape, np.inf)
+    dist[start] = 0.0
+    queue = [(0.0, start)]
+    while queue:
+        d, (r, c) = heapq.heappop(queue)
+        if d > dist[r, c]:
+            continue
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                nr, nc = r + dr, c + dc
+                if (dr, dc) == (0, 0) or not (0 <= nr < height and 0 <= nc < width):
+                    continue
+                if not traversable[nr, nc]:
+                    continue
+                if dr and dc and not (traversable[r + dr, c] and traversable[r, c + dc]):
+                    continue
+                step = RES * (math.sqrt(2.0) if dr and dc else 1.0)
+                if d + step < dist[nr, nc]:
+                    dist[nr, nc] = d + step
+                    heapq.heappush(queue, (d + step, (nr, nc)))
+    return dist
+
+
+def brute_costs(grid, evader_pose, pursuer_pose, distance) -> np.ndarray:
+    """Algorithm 2's cost (H, W) for every candidate cell by plain loops; inf elsewhere."""
+    visible = visibility_region(grid, pursuer_pose, CAMERA)
+    e_trav = Planner(grid, EVADER.radius).traversable
+    p_trav = Planner(grid, PURSUER.radius).traversable
+    e_cell, p_cell = cell_of((evader_pose.x, evader_pose.y)), cell_of((pursuer_pose.x, pursuer_pose.y))
+    reach = bfs_reachable(e_trav, e_cell)
+    if distance == "geodesic":
+        e_dist, p_dist = dijkstra(e_trav, e_cell), dijkstra(p_trav, p_cell)
+    cost = np.full(grid.data.shape, np.inf)
+    for r in range(grid.height):
+        for c in range(grid.width):
+            if grid.data[r, c] != FREE or not reach[r, c] or visible[r, c]:
+                continue
+            if distance == "euclidean":
+                x, y = centre(r, c)
+                effort = math.hypot(x - evader_pose.x, y - evader_pose.y)
+                dist = math.hypot(x - pursuer_pose.x, y - pursuer_pose.y)
+            else:
+                effort, dist = e_dist[r, c], p_dist[r, c]
+            cost[r, c] = math.inf if dist == 0 else effort / dist
+    return cost
+
+
+def brute_argmin(cost: np.ndarray) -> tuple[int, int]:
+    """Lowest cost, then lowest row-major index, by a plain loop (costs equal up to 1e-12)."""
+    best, best_cell = math.inf, None
+    for r in range(cost.shape[0]):
+        for c in range(cost.shape[1]):
+            if cost[r, c] < best * (1 - 1e-12):
+                best, best_cell = cost[r, c], (r, c)
+    return best_cell
+
+
+def random_scene(seed: int):
+    """A 30 x 30 grid with random blocks, a pursuer pose and an evader pose (in view when
+    possible), both in cells traversable for their bodies."""
+    rng = np.random.default_rng(seed)
+    blocks = []
+    for _ in range(5):
+        r, c = rng.integers(3, 25, 2)
+        blocks.append((r, r + rng.integers(1, 5), c, c + rng.integers(1, 5)))
+    grid = walled_grid(30, 30, blocks)
+    p_rows, p_cols = np.nonzero(Planner(grid, PURSUER.radius).traversable)
+    k = rng.integers(p_rows.size)
+    pursuer = Pose(*centre(p_rows[k], p_cols[k]), rng.uniform(-math.pi, math.pi))
+    e_trav = Planner(grid, EVADER.radius).traversable
+    in_view = e_trav & visibility_region(grid, pursuer, CAMERA)
+    e_rows, e_cols = np.nonzero(in_view if in_view.any() else e_trav)
+    k = rng.integers(e_rows.size)
+    jitter = rng.uniform(-0.4, 0.4, 2) * RES
+    x, y = centre(e_rows[k], e_cols[k])
+    return grid, pursuer, Pose(x + jitter[0], y + jitter[1], rng.uniform(-math.pi, math.pi))
+
+
+# ---------------------------------------------------------------------------- tests
+
+
+@pytest.mark.parametrize("distance", ["euclidean", "geodesic"])
+@pytest.mark.parametrize("seed", range(6))
+def test_goal_is_the_brute_force_argmin(distance, seed):
+    grid, pursuer, me = random_scene(seed)
+    smart = make_evader(grid, distance)
+    smart.reset(me)
+    plan = smart.decide(EvaderObservation(0.0, me, pursuer))
+    cost = brute_costs(grid, me, pursuer, distance)
+    expected = brute_argmin(cost)
+    goal = cell_of(plan.goal)
+    assert goal == expected
+    assert not visibility_region(grid, pursuer, CAMERA)[goal]
+    assert Planner(grid, EVADER.radius).reachable((me.x, me.y))[goal]
+    assert plan.info["escape_cost"] == pytest.approx(cost[expected], rel=1e-9, abs=1e-12)
+    assert len(plan.path) > 0
+
+
+def test_hidden_spot_behind_a_wall_beats_open_space():
+    # Pursuer at the left looking right (+x) at the evader, a wall just behind the evader.
+    wall = (22, 38, 35, 37)  # rows 22..37 (y 2.2-3.8 m), cols 35..36 (x 3.5-3.7 m)
+    pursuer = Pose(1.05, 3.05, 0.0)
+    me = Pose(3.05, 3.05, 0.0)
+    walled = walled_grid(60, 60, [wall])
+    plan = make_evader(walled).decide(EvaderObservation(0.0, me, pursuer))
+    goal_x, goal_y = plan.goal
+    assert goal_x > 3.7 and 2.2 < goal_y < 3.8  # in the wall's shadow
+    # Every candidate outside the shadow costs more by the formula.
+    cost = brute_costs(walled, me, pursuer, "euclidean")
+    rows, cols = np.nonzero(np.isfinite(cost))
+    x, y = (cols + 0.5) * RES, (rows + 0.5) * RES
+    open_space = ~((x > 3.7) & (y > 2.2) & (y < 3.8))
+    assert cost[rows, cols][open_space].min() > plan.info["escape_cost"]
+    # Without the wall the same scene sends the evader out of the FOV wedge instead.
+    open_plan = make_evader(walled_grid(60, 60)).decide(EvaderObservation(0.0, me, pursuer))
+    bearing = math.atan2(open_plan.goal[1] - pursuer.y, open_plan.goal[0] - pursuer.x)
+    assert abs(bearing) > CAMERA.fov / 2
+
+
+def test_cells_the_pursuer_cannot_reach_are_ideal_with_geodesic_distances():
+    # A closet behind a 3-cell gap: wide enough for a small evader, not for a big pursuer.
+    small, big = Body(0.05, 0.5, 1.8), Body(0.3, 0.5, 1.8)
+    grid = walled_grid(40, 40, [(20, 21, 1, 20), (20, 21, 23, 39)])  # gap at cols 20..22
+    pursuer, me = Pose(1.05, 0.85, 0.3), Pose(2.05, 1.05, 0.0)
+    smart = make_evader(grid, "geodesic", evader=small, pursuer=big)
+    plan = smart.decide(EvaderObservation(0.0, me, pursuer))
+    closet = Planner(grid, small.radius).reachable((me.x, me.y)) & ~Planner(grid, big.radius).reachable(
+        (pursuer.x, pursuer.y))
+    hidden = closet & ~visibility_region(grid, pursuer, CAMERA)
+    assert plan.info["escape_cost"] == 0.0
+    rows, cols = np.nonzero(hidden)
+    assert cell_of(plan.goal) == (rows[0], cols[0])  # ties: lowest row-major index
+
+
+@pytest.mark.parametrize("distance", ["euclidean", "geodesic"])
+def test_evader_out_of_sight_stays_put(distance):
+    # Behind the pursuer, the evader's own cell is the cheapest by Algorithm 2.
+    grid = walled_grid(40, 40)
+    pursuer, me = Pose(2.05, 2.05, 0.0), Pose(1.03, 2.07, 0.0)
+    plan = make_evader(grid, distance).decide(EvaderObservation(0.0, me, pursuer))
+    goal, own = cell_of(plan.goal), cell_of((me.x, me.y))
+    assert max(abs(goal[0] - own[0]), abs(goal[1] - own[1])) <= 1
+    if distance == "geodesic":
+        assert goal == own and plan.info["escape_cost"] == 0.0
+
+
+def test_no_candidate_keeps_the_current_plan(caplog):
+    # A 1 m room; a camera seeing all around covers every cell the evader can reach.
+    grid = walled_grid(10, 10)
+    everywhere = Camera(fov=2 * math.pi, near=0.0, far=2.0, angle_step=0.002, distance_step=0.02)
+    smart = make_evader(grid, camera=everywhere)
+    me = Pose(0.45, 0.45, 0.0)
+    # A camera inside the wall sees nothing, so the first decision has a goal.
+    first = smart.decide(EvaderObservation(0.0, me, Pose(0.05, 0.05, 0.0)))
+    assert first.goal is not None
+    with caplog.at_level(logging.INFO, logger="pegame.evaders.smart"):
+        plan = smart.decide(EvaderObservation(1.0, me, Pose(0.55, 0.55, 0.0)))
+    assert "keeping the current plan" in caplog.text
+    assert plan.goal == first.goal and plan.path is first.path
+    assert plan.info["candidates"].shape == (0, 2)
+    assert plan.info["escape_cost"] == math.inf
+    # From a fresh start there is no plan to keep: the evader stops.
+    fresh = make_evader(grid, camera=everywhere)
+    fresh.reset(me)
+    assert fresh.decide(EvaderObservation(0.0, me, Pose(0.55, 0.55, 0.0))).goal is None
+    command = fresh.control(EvaderObservation(0.0, me, Pose(0.55, 0.55, 0.0)))
+    assert (command.v, command.w) == (0.0, 0.0)
+
+
+def test_evader_moves_toward_its_goal():
+    grid = walled_grid(60, 60, [(22, 38, 35, 37)])
+    pursuer, pose = Pose(1.05, 3.05, 0.0), Pose(3.05, 3.05, math.pi / 2)
+    smart = make_evader(grid)
+    smart.reset(pose)
+    plan = smart.decide(EvaderObservation(0.0, pose, pursuer))
+    start_gap = math.dist((pose.x, pose.y), plan.goal)
+    dt = 0.1
+    for step in range(100):  # 10 s of unicycle motion; the path around the wall is ~2.7 m
+        cmd = smart.control(EvaderObservation(step * dt, pose, pursuer))
+        assert abs(cmd.v) <= EVADER.v_max + 1e-9 and abs(cmd.w) <= EVADER.w_max + 1e-9
+        theta = pose.theta + cmd.w * dt
+        pose = Pose(pose.x + cmd.v * math.cos(theta) * dt, pose.y + cmd.v * math.sin(theta) * dt, theta)
+        assert not grid.blocked[cell_of((pose.x, pose.y))]
+    assert math.dist((pose.x, pose.y), plan.goal) < min(0.3, 0.5 * start_gap)
+
+
+def test_same_goal_keeps_the_path_and_info_is_bounded():
+    grid = walled_grid(60, 60, [(22, 38, 35, 37)])
+    pursuer, me = Pose(1.05, 3.05, 0.0), Pose(3.05, 3.05, 0.0)
+    smart = make_evader(grid)
+    first = smart.decide(EvaderObservation(0.0, me, pursuer))
+    second = smart.decide(EvaderObservation(1.0, me, pursuer))
+    assert second.path is first.path and second.goal == first.goal
+    candidates = second.info["candidates"]
+    assert candidates.ndim == 2 and candidates.shape[1] == 2
+    assert 0 < len(candidates) <= MAX_RECORDED_CANDIDATES
+    assert np.array_equal(candidates, first.info["candidates"])
+
+
+def test_candidate_stride_scores_every_kth_cell():
+    grid, pursuer, me = random_scene(1)
+    smart = make_evader(grid, candidate_stride=3)
+    rows, cols = np.divmod(smart.candidates(me, pursuer), grid.width)
+    assert rows.size > 0 and np.all(rows % 3 == 0) and np.all(cols % 3 == 0)
+    assert rows.size < make_evader(grid).candidates(me, pursuer).size / 4
+    goal = cell_of(smart.decide(EvaderObservation(0.0, me, pursuer)).goal)
+    assert goal[0] % 3 == 0 and goal[1] % 3 == 0
+
+
+@pytest.mark.parametrize(
+    "params, key",
+    [({"distance": "manhattan"}, "evader.distance"),
+     ({"candidate_stride": 0}, "evader.candidate_stride"),
+     ({"radius": -1.0}, "evader.radius")],
+)
+def test_bad_config_names_the_key(params, key):
+    with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
+        make_config("evader", SmartEvader, params)
