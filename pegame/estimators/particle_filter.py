@@ -1,0 +1,347 @@
+"""Particle filter tracking of the evader (paper, Secs. "Particle Filter based Tracking"
+and "Smart Pursuer").
+
+Sequential Importance Sampling (SIS) over the evader state (x m, y m, theta rad) in the map
+frame (x right, y up, theta from +x, counter-clockwise, in (-pi, pi]). The filter is given
+the map (``context.grid``), the evader's max speed (``context.evader.v_max``, m/s) and, at
+every control tick, the pursuer's detection (or None) and visibility region V_k^p (a bool
+mask over the grid); never the true evader pose.
+
+- Motion model, the paper's unicycle u = [V cos(phi), V sin(phi), omega]: every particle
+  draws a speed V ~ U[0, v_max] (m/s) and a turn rate omega ~ N(0, turn_rate_std^2) (rad/s)
+  and moves for dt seconds along the heading at the middle of the step.
+- Measurement model: with a detection at z (map frame, m), w_i *= exp(-|p_i - z|^2 /
+  (2 sigma^2)) and particles inside V_k^p are multiplied by seen_boost; without one,
+  particles inside V_k^p are multiplied by miss_factor (negative information: the evader
+  would have been seen there). Particles in blocked cells (occupied or unknown) or off the
+  grid get weight 0. Weights are then normalised to sum to 1.
+- Degeneracy, the paper's Eq. for the effective sample size: N_eff = 1 / sum_i w_i^2. When
+  N_eff < rho * N (0 <= rho <= 1, the paper uses rho = 0.8) the particles are resampled and
+  the weights reset to 1/N.
+- Lost track: the set is redrawn when the weights vanish (their sum is 0 or not finite),
+  or when a detection is unexplained by the predicted set, i.e. its likelihood
+  sum_i w_i exp(-|p_i - z|^2 / (2 sigma^2)) is below exp(-LOST_GATE^2 / 2), as if every
+  particle were LOST_GATE sigmas away. Otherwise the few far particles nearest to z would
+  take all the weight and the estimate would crawl towards z at the evader's speed. The
+  new set is drawn around the detection when there is one, else uniformly over the free
+  cells outside V_k^p.
+
+The estimate is the weighted mean of the particle positions (the paper), with their
+weighted covariance (m^2).
+
+The resampling schemes are filterpy.monte_carlo's systematic, stratified, residual and
+multinomial resampling, written here as vectorised numpy on the plugin's own Generator:
+filterpy's draw from numpy's global RNG (not reproducible per component), loop in Python
+(about 1 ms for 2000 particles) and its residual_resample computes the residual from
+w instead of N w (filterpy issue #290). The tests compare these against filterpy's.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from scipy.ndimage import distance_transform_edt
+
+from pegame.api import Belief, Detection, Estimator, Pose
+from pegame.errors import MapError, require
+
+log = logging.getLogger(__name__)
+
+RESAMPLERS = ("systematic", "stratified", "residual", "multinomial")
+#: a detection this many sigmas from all the particles' weight means the track is lost
+LOST_GATE = 5.0
+#: redraws of initial particles that land in blocked cells before snapping them to free ones
+RESEED_TRIES = 5
+
+
+def wrap(angles: np.ndarray) -> np.ndarray:
+    """Wrap angles (rad) to (-pi, pi]."""
+    return np.pi - np.mod(np.pi - angles, 2.0 * np.pi)
+
+
+def effective_sample_size(weights: np.ndarray) -> float:
+    """N_eff = 1 / sum(w^2) of normalised weights (N,) (the paper's Eq.)."""
+    return 1.0 / float(np.dot(weights, weights))
+
+
+def resample(weights: np.ndarray, scheme: str, rng: np.random.Generator) -> np.ndarray:
+    """Indices (N,) of the particles drawn with ``scheme`` (one of RESAMPLERS) from the
+    non-negative ``weights`` (N,), which need not sum to 1 but must have a positive sum.
+
+    Same draws as filterpy.monte_carlo's functions fed the same uniform numbers (residual:
+    with the residual N w - floor(N w), the published algorithm). Only particles of
+    positive weight are ever drawn.
+    """
+    n = weights.size
+    w = weights / weights.sum()
+    if scheme == "residual":
+        copies = np.floor(n * w).astype(np.int64)
+        kept = np.repeat(np.arange(n), copies)
+        rest = n - kept.size
+        if rest == 0:
+            return kept
+        return np.concatenate([kept, _invert(n * w - copies, rng.random(rest))])
+    if scheme == "systematic":
+        positions = (rng.random() + np.arange(n)) / n
+    elif scheme == "stratified":
+        positions = (rng.random(n) + np.arange(n)) / n
+    elif scheme == "multinomial":
+        positions = rng.random(n)
+    else:
+        raise ValueError(f"Unknown resampler {scheme!r}; use one of {', '.join(RESAMPLERS)}.")
+    return _invert(w, positions)
+
+
+def _invert(weights: np.ndarray, positions: np.ndarray) -> np.ndarray:
+    """For each position in [0, 1), the index whose cumulative-weight interval holds it."""
+    cumulative = np.cumsum(weights)
+    cumulative /= cumulative[-1]
+    indices = np.searchsorted(cumulative, positions, side="right")
+    # Round-off can leave the cumulative sum just below 1, or make the last systematic
+    # position exactly 1, and searchsorted then returns N: such positions belong to the
+    # last particle of positive weight (never to a trailing zero-weight one).
+    return np.minimum(indices, np.flatnonzero(weights)[-1])
+
+
+class ParticleFilter(Estimator):
+    """SIS particle filter over the evader's (x, y, theta), with negative information."""
+
+    description = "SIS particle filter over the evader's pose with negative information (paper)."
+
+    @dataclass
+    class Config:
+        n_particles: int = 2000  # number of particles N
+        rho: float = 0.8  # resample when N_eff < rho * N, in [0, 1] (the paper's 0.8)
+        resampler: str = "systematic"  # systematic, stratified, residual or multinomial
+        sigma: float = 0.3  # m, std of the Gaussian likelihood of a detected position
+        turn_rate_std: float = 1.0  # rad/s, std of the motion model's random turn rate
+        seen_boost: float = 2.0  # weight factor (>= 1) inside the visible region on a detection
+        miss_factor: float = 0.05  # weight factor in [0, 1] inside the visible region on a miss
+        init_spread: float = 0.3  # m, std of the initial cloud around the first detection
+
+        def __post_init__(self) -> None:
+            key = "estimator.{}".format
+            require(self.n_particles >= 1, key("n_particles"), "an integer >= 1", self.n_particles)
+            allowed = "one of " + ", ".join(RESAMPLERS)
+            require(self.resampler in RESAMPLERS, key("resampler"), allowed, self.resampler)
+            require(0.0 <= self.rho <= 1.0, key("rho"), "[0, 1]", self.rho)
+            require(self.sigma > 0.0, key("sigma"), "a std > 0 m", self.sigma)
+            turn = self.turn_rate_std
+            require(turn >= 0.0, key("turn_rate_std"), "a std >= 0 rad/s", turn)
+            require(self.seen_boost >= 1.0, key("seen_boost"), "a factor >= 1", self.seen_boost)
+            require(0.0 <= self.miss_factor <= 1.0, key("miss_factor"), "[0, 1]", self.miss_factor)
+            require(self.init_spread >= 0.0, key("init_spread"), "a std >= 0 m", self.init_spread)
+            for name in ("sigma", "turn_rate_std", "seen_boost", "init_spread"):
+                value = getattr(self, name)
+                require(math.isfinite(value), key(name), "a finite number", value)
+
+    def __init__(self, config: Config, context, rng: np.random.Generator) -> None:
+        super().__init__(config, context, rng)
+        grid = context.grid
+        self._blocked = grid.blocked.ravel()
+        self._free_cells = np.flatnonzero(~self._blocked)
+        if self._free_cells.size == 0:
+            raise MapError(f"Map '{grid.name}' has no free cell for the particle filter to use.")
+        n = config.n_particles
+        self.particles = np.zeros((n, 3))
+        self.weights = np.full(n, 1.0 / n)
+
+    # ------------------------------------------------------------------ interface
+
+    def reset(self, pursuer: Pose, detection: Detection | None, visible: np.ndarray) -> Belief:
+        """Draw the initial particles: around the detection if any (N(z, init_spread) on
+        free cells), else uniformly over the free cells inside ``visible`` (or over all
+        free cells when none is visible); headings uniform, weights 1/N."""
+        if detection is not None:
+            if not self.context.grid.is_free(*detection.position):
+                log.info(
+                    "The first detection %s lies in a blocked cell or off the map; starting "
+                    "the particles on the free cells around it.", detection.position
+                )
+            self.particles = self._around(detection.position)
+        else:
+            inside = self._free_cells[self._flat_mask(visible)[self._free_cells]]
+            self.particles = self._uniform(inside if inside.size else self._free_cells)
+        n = self.config.n_particles
+        self.weights = np.full(n, 1.0 / n)
+        return self._belief(float(n), resampled=False)
+
+    def update(
+        self, dt: float, pursuer: Pose, detection: Detection | None, visible: np.ndarray
+    ) -> Belief:
+        """Predict ``dt`` s with the unicycle model, weigh by the detection (or its absence)
+        and ``visible`` (bool (H, W) over the grid), resample when N_eff < rho * N.
+
+        The belief's ``n_eff`` is N_eff of the normalised weights before any resampling
+        (the value compared with rho * N), or 0 when the particle set was lost and redrawn.
+        """
+        cfg = self.config
+        moved = self._predict(dt)
+        flat, on_grid = self._cells(moved[:, 0], moved[:, 1])
+        valid = on_grid & ~self._blocked[flat]
+        seen = on_grid & self._flat_mask(visible)[flat]
+        prior = self.weights
+        if detection is None:
+            lost = False
+            factor = np.where(seen, cfg.miss_factor, 1.0)
+        else:
+            likelihood = self._likelihood(moved, detection.position) * valid
+            lost = float(np.dot(prior, likelihood)) < math.exp(-0.5 * LOST_GATE**2)
+            factor = likelihood * np.where(seen, cfg.seen_boost, 1.0)
+        weights = prior * factor * valid
+        total = float(weights.sum())
+        if lost or not (total > 0.0 and math.isfinite(total)):
+            return self._reinitialise(detection, visible)
+        weights /= total
+        n_eff = effective_sample_size(weights)
+        resampled = n_eff < cfg.rho * cfg.n_particles
+        if resampled:
+            moved = moved[resample(weights, cfg.resampler, self.rng)]
+            weights = np.full(cfg.n_particles, 1.0 / cfg.n_particles)
+        self.particles, self.weights = moved, weights
+        return self._belief(n_eff, resampled)
+
+    # ------------------------------------------------------------------ models
+
+    def _predict(self, dt: float) -> np.ndarray:
+        """The particles (N, 3) moved by the unicycle model over dt seconds."""
+        n, p = self.config.n_particles, self.particles
+        speed = self.rng.uniform(0.0, self.context.evader.v_max, n)
+        turn = self.config.turn_rate_std * self.rng.standard_normal(n)
+        heading = p[:, 2] + 0.5 * turn * dt
+        return np.column_stack(
+            (
+                p[:, 0] + speed * dt * np.cos(heading),
+                p[:, 1] + speed * dt * np.sin(heading),
+                wrap(p[:, 2] + turn * dt),
+            )
+        )
+
+    def _likelihood(self, particles: np.ndarray, position: tuple[float, float]) -> np.ndarray:
+        """Gaussian likelihood (N,) of the detected map position (m) for each particle."""
+        dx = particles[:, 0] - position[0]
+        dy = particles[:, 1] - position[1]
+        return np.exp(-(dx * dx + dy * dy) / (2.0 * self.config.sigma**2))
+
+    # ------------------------------------------------------------------ sampling
+
+    def _reinitialise(self, detection: Detection | None, visible: np.ndarray) -> Belief:
+        """Redraw the lost particle set: around the detection, or uniformly over the free
+        cells outside ``visible`` (all free cells when every one is visible)."""
+        if detection is not None:
+            log.info(
+                "Particle filter lost the track (no particle near the detection %s); "
+                "redrawing the particles around it.", detection.position
+            )
+            self.particles = self._around(detection.position)
+        else:
+            log.info(
+                "Particle filter weights vanished; redrawing the particles uniformly over "
+                "the free cells outside the pursuer's view."
+            )
+            hidden = self._free_cells[~self._flat_mask(visible)[self._free_cells]]
+            self.particles = self._uniform(hidden if hidden.size else self._free_cells)
+        n = self.config.n_particles
+        self.weights = np.full(n, 1.0 / n)
+        return self._belief(0.0, resampled=True)
+
+    def _around(self, position: tuple[float, float]) -> np.ndarray:
+        """N particles (N, 3) from N(position, init_spread^2) on free cells, headings
+        uniform. Draws in blocked cells are redrawn a few times, then moved to the centre
+        of the nearest free cell (the detection may itself lie in an obstacle)."""
+        n, spread = self.config.n_particles, self.config.init_spread
+        xy = self.rng.normal(position, spread, (n, 2))
+        for _ in range(RESEED_TRIES):
+            bad = ~self._valid(xy)
+            if not bad.any():
+                break
+            xy[bad] = self.rng.normal(position, spread, (int(bad.sum()), 2))
+        bad = ~self._valid(xy)
+        if bad.any():
+            xy[bad] = self._nearest_free(xy[bad])
+        return np.column_stack((xy, self._headings(n)))
+
+    def _uniform(self, cells: np.ndarray) -> np.ndarray:
+        """N particles (N, 3) uniform over the given flat cell indices, headings uniform."""
+        n, width = self.config.n_particles, self.context.grid.width
+        rows, cols = np.divmod(cells[self.rng.integers(cells.size, size=n)], width)
+        # cell_to_world maps (row, col) to the cell centre; a U(-0.5, 0.5) offset spreads
+        # the particle uniformly over the cell.
+        x, y = self.context.grid.cell_to_world(
+            rows + self.rng.random(n) - 0.5, cols + self.rng.random(n) - 0.5
+        )
+        return np.column_stack((x, y, self._headings(n)))
+
+    def _headings(self, n: int) -> np.ndarray:
+        return wrap(self.rng.uniform(-np.pi, np.pi, n))
+
+    # ------------------------------------------------------------------ grid lookups
+
+    def _cells(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Flat cell index (N,) of map-frame points (m), 0 where off the grid, and the bool
+        (N,) mask of points on the grid."""
+        grid = self.context.grid
+        row, col = grid.world_to_cell(x, y)
+        on_grid = (row >= 0) & (row < grid.height) & (col >= 0) & (col < grid.width)
+        return np.where(on_grid, row * grid.width + col, 0), on_grid
+
+    def _valid(self, xy: np.ndarray) -> np.ndarray:
+        """True where a point (N, 2) (m) lies on a free cell of the grid."""
+        flat, on_grid = self._cells(xy[:, 0], xy[:, 1])
+        return on_grid & ~self._blocked[flat]
+
+    def _flat_mask(self, visible: np.ndarray) -> np.ndarray:
+        """The visibility mask (H, W) as a flat bool array, checked against the grid."""
+        grid = self.context.grid
+        if visible.shape != (grid.height, grid.width):
+            raise ValueError(
+                f"The visibility mask has shape {visible.shape}; the grid's is "
+                f"{(grid.height, grid.width)}."
+            )
+        return visible.ravel()
+
+    @cached_property
+    def _nearest_free_cell(self) -> np.ndarray:
+        """Flat index of the nearest free cell, per flat cell index (H * W,); built once,
+        only when a draw needs it."""
+        grid = self.context.grid
+        rows, cols = distance_transform_edt(
+            grid.blocked, return_distances=False, return_indices=True
+        )
+        return (rows * grid.width + cols).ravel()
+
+    def _nearest_free(self, xy: np.ndarray) -> np.ndarray:
+        """Centres (K, 2) (m) of the free cells nearest to points (K, 2) (m), on or off the grid."""
+        grid = self.context.grid
+        row, col = grid.world_to_cell(xy[:, 0], xy[:, 1])
+        row = np.clip(row, 0, grid.height - 1)
+        col = np.clip(col, 0, grid.width - 1)
+        rows, cols = np.divmod(self._nearest_free_cell[row * grid.width + col], grid.width)
+        return np.column_stack(grid.cell_to_world(rows, cols))
+
+    # ------------------------------------------------------------------ output
+
+    def _belief(self, n_eff: float, resampled: bool) -> Belief:
+        """The belief: weighted mean (m) and covariance (m^2) of the particle positions.
+
+        The particle and weight arrays are shared with the belief, so they are made
+        read-only; every update builds new ones.
+        """
+        self.particles.setflags(write=False)
+        self.weights.setflags(write=False)
+        xy, w = self.particles[:, :2], self.weights
+        mean = w @ xy
+        offset = xy - mean
+        covariance = (offset * w[:, None]).T @ offset
+        return Belief(
+            mean=(float(mean[0]), float(mean[1])),
+            covariance=covariance,
+            particles=self.particles,
+            weights=self.weights,
+            n_eff=n_eff,
+            resampled=resampled,
+        )

@@ -1,0 +1,460 @@
+"""Tests for the estimators: particle filter (paper's SIS with N_eff and rho), Kalman, last seen."""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import fields
+from pathlib import Path
+
+import filterpy.monte_carlo.resampling as filterpy_resampling
+import numpy as np
+import pytest
+import yaml
+
+from pegame import registry
+from pegame.api import Body, BoundingBox, Camera, Context, Detection, Pose
+from pegame.errors import ConfigError
+from pegame.estimators.kalman import KalmanEstimator
+from pegame.estimators.last_seen import LastSeen
+from pegame.estimators.particle_filter import (
+    RESAMPLERS,
+    ParticleFilter,
+    resample,
+)
+from pegame.maps import FREE, OCCUPIED, OccupancyGrid
+
+CONF = Path(__file__).resolve().parents[1] / "conf" / "estimator"
+DT = 0.1  # s, control period
+PURSUER = Pose(0.5, 0.5, 0.0)  # the estimators here do not use the pursuer's pose
+LOGGER = "pegame.estimators.particle_filter"
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def room(height=40, width=50, resolution=0.1):
+    """A walled room (4 m x 5 m at 0.1 m) with an occupied block at x 3.0-3.5 m, y 1.0-3.0 m."""
+    data = np.full((height, width), FREE, dtype=np.int8)
+    data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = OCCUPIED
+    data[10:30, 30:35] = OCCUPIED
+    return OccupancyGrid(data, resolution)
+
+
+def context(grid, v_max=0.5):
+    return Context(
+        grid=grid,
+        pursuer=Body(0.2, v_max, 1.8),
+        evader=Body(0.25, v_max, 1.8),
+        camera=Camera(),
+        control_dt=DT,
+        decision_dt=1.0,
+    )
+
+
+def build(cls, grid, seed=0, **params):
+    """A plugin built through the registry's config path, as the game builds it."""
+    config = registry.make_config("estimator", cls, params)
+    return cls(config, context(grid), np.random.default_rng(seed))
+
+
+def detection(x, y):
+    box = BoundingBox(0.0, 0.0, 10.0, 10.0)
+    return Detection(box=box, depth=1.0, position=(float(x), float(y)))
+
+
+def disc(grid, center, radius):
+    """Bool (H, W) mask of the cells whose centre lies within ``radius`` m of ``center``."""
+    rows, cols = np.mgrid[0 : grid.height, 0 : grid.width]
+    x, y = grid.cell_to_world(rows, cols)
+    return (x - center[0]) ** 2 + (y - center[1]) ** 2 <= radius**2
+
+
+def cell_values(grid, particles, mask):
+    """``mask`` (H, W) at each particle's cell (N,); False off the grid."""
+    row, col = grid.world_to_cell(particles[:, 0], particles[:, 1])
+    on_grid = grid.contains(row, col)
+    return on_grid & mask[np.clip(row, 0, grid.height - 1), np.clip(col, 0, grid.width - 1)]
+
+
+def on_free(grid, particles):
+    return cell_values(grid, particles, grid.free)
+
+
+class Constant:
+    """A stand-in for a Generator whose uniform draws all equal ``value``."""
+
+    def __init__(self, value):
+        self.value = value
+
+    def random(self, size=None):
+        return self.value if size is None else np.full(size, self.value)
+
+
+# --------------------------------------------------------------------------- configs
+
+
+@pytest.mark.parametrize(
+    "cls, stem", [(ParticleFilter, "particle_filter"), (KalmanEstimator, "kalman")]
+)
+def test_config_file_matches_config_class(cls, stem):
+    doc = yaml.safe_load((CONF / f"{stem}.yaml").read_text())
+    assert doc.pop("name") == stem
+    assert registry.load("estimator", stem) is cls
+    defaults = {f.name: f.default for f in fields(cls.Config)}
+    assert doc == defaults
+    assert registry.make_config("estimator", cls, doc) == cls.Config()
+
+
+@pytest.mark.parametrize(
+    "cls, key, value",
+    [
+        (ParticleFilter, "n_particles", 0),
+        (ParticleFilter, "rho", 1.5),
+        (ParticleFilter, "sigma", -1.0),
+        (ParticleFilter, "resampler", "foo"),
+        (ParticleFilter, "miss_factor", 1.5),
+        (ParticleFilter, "seen_boost", 0.5),
+        (KalmanEstimator, "measurement_std", 0.0),
+        (KalmanEstimator, "accel_std", -1.0),
+    ],
+)
+def test_bad_config_names_the_key(cls, key, value):
+    with pytest.raises(ConfigError, match=f"estimator.{key}") as info:
+        registry.make_config("estimator", cls, {key: value})
+    if key == "resampler":
+        assert all(name in str(info.value) for name in RESAMPLERS)
+
+
+# --------------------------------------------------------------------------- particle filter
+
+
+def test_weights_stay_normalised_over_a_long_run():
+    grid = room()
+    pf = build(ParticleFilter, grid, seed=1, n_particles=500)
+    rng = np.random.default_rng(2)
+    target = np.array([1.5, 2.0])
+    belief = pf.reset(PURSUER, detection(*target), disc(grid, target, 1.5))
+    resamples = 0
+    for _ in range(300):
+        # The target walks at up to 0.4 m/s inside the free part left of the block.
+        target = np.clip(target + rng.uniform(-0.04, 0.04, 2), [0.3, 0.3], [2.7, 3.7])
+        view = disc(grid, rng.uniform([0.5, 0.5], [4.5, 3.5]), 1.2)
+        seen = bool(cell_values(grid, target[None, :], view)[0])
+        found = detection(*(target + rng.normal(0.0, 0.1, 2))) if seen else None
+        belief = pf.update(DT, PURSUER, found, view)
+        w = belief.weights
+        assert np.all(np.isfinite(w)) and np.all(w >= 0)
+        assert w.sum() == pytest.approx(1.0, abs=1e-9)
+        assert 1.0 <= belief.n_eff <= 500 + 1e-9
+        assert np.all(np.isfinite(belief.particles)) and np.all(np.isfinite(belief.covariance))
+        assert np.all(w[~on_free(grid, belief.particles)] == 0)
+        resamples += belief.resampled
+    assert 0 < resamples < 300
+
+
+def test_localises_a_stationary_target():
+    grid = room()
+    target = np.array([2.0, 2.5])
+    view = disc(grid, target, 1.5)
+    rng = np.random.default_rng(3)
+    pf = build(ParticleFilter, grid, seed=4)
+    pf.reset(PURSUER, detection(*(target + rng.normal(0.0, 0.1, 2))), view)
+    for _ in range(8):
+        belief = pf.update(DT, PURSUER, detection(*(target + rng.normal(0.0, 0.1, 2))), view)
+    assert math.dist(belief.mean, target) < 0.3
+
+
+def test_negative_information_moves_mass_out_of_the_seen_region():
+    grid = room()
+    pf = build(ParticleFilter, grid, seed=5, rho=0.0, init_spread=0.5)
+    start = pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 2.0))
+    view = disc(grid, (2.0, 2.0), 0.5)  # covers the cloud's right part
+    before = start.weights[cell_values(grid, start.particles, view)].sum()
+    after = pf.update(0.0, PURSUER, None, view)  # dt 0: only the measurement acts
+    inside = cell_values(grid, after.particles, view)
+    mass = after.weights[inside].sum()
+    assert 0.1 < before < 0.9
+    expected = 0.05 * before / (0.05 * before + (1.0 - before))  # miss_factor 0.05
+    assert mass == pytest.approx(expected, rel=1e-9)
+    assert after.mean[0] < start.mean[0]  # the belief moves away from the seen region
+
+
+def reference_weights(grid, cfg, particles, prior, found, view):
+    """The measurement update written particle by particle: the model in plain Python."""
+    weights = []
+    for (x, y, _), w in zip(particles, prior):
+        row, col = grid.world_to_cell(x, y)
+        if not grid.contains(row, col) or grid.blocked[row, col]:
+            weights.append(0.0)
+        elif found is None:
+            weights.append(w * (cfg.miss_factor if view[row, col] else 1.0))
+        else:
+            zx, zy = found.position
+            likelihood = math.exp(-((x - zx) ** 2 + (y - zy) ** 2) / (2 * cfg.sigma**2))
+            weights.append(w * likelihood * (cfg.seen_boost if view[row, col] else 1.0))
+    return np.array(weights) / sum(weights)
+
+
+def test_weight_update_matches_the_per_particle_reference():
+    grid = room()
+    pf = build(ParticleFilter, grid, seed=25, n_particles=300, rho=0.0, init_spread=0.6)
+    belief = pf.reset(PURSUER, detection(2.6, 2.0), disc(grid, (2.6, 2.0), 1.0))
+    rng = np.random.default_rng(26)
+    for step in range(12):
+        view = disc(grid, rng.uniform([1.5, 1.0], [3.0, 3.0]), 0.8)
+        found = detection(*rng.normal([2.6, 2.0], 0.1)) if step % 2 else None
+        prior = belief.weights
+        belief = pf.update(DT, PURSUER, found, view)
+        expected = reference_weights(grid, pf.config, belief.particles, prior, found, view)
+        np.testing.assert_allclose(belief.weights, expected, rtol=1e-9, atol=1e-15)
+
+
+def test_resampling_happens_exactly_below_rho_times_n():
+    grid = room()
+    n = 400
+
+    def first_update(rho):
+        pf = build(ParticleFilter, grid, seed=6, n_particles=n, rho=rho, init_spread=0.5)
+        pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
+        return pf.update(DT, PURSUER, detection(1.7, 2.1), disc(grid, (1.5, 2.0), 1.0))
+
+    # rho = 0 never resamples, so its weights are the pre-resampling weights of every rho:
+    # resampling is the update's last step and the only one rho changes.
+    kept = first_update(0.0)
+    n_eff = 1.0 / np.sum(kept.weights**2)
+    assert not kept.resampled and kept.n_eff == pytest.approx(n_eff, rel=1e-12)
+    assert 1.0 < n_eff < n
+    above = first_update(min(1.0, float(n_eff / n * (1 + 1e-9))))
+    below = first_update(float(n_eff / n * (1 - 1e-9)))
+    assert above.resampled and not below.resampled
+    assert above.n_eff == pytest.approx(n_eff) and below.n_eff == pytest.approx(n_eff)
+    assert np.all(above.weights == 1.0 / n)
+    np.testing.assert_array_equal(below.weights, kept.weights)
+
+
+@pytest.mark.parametrize("rho", [0.0, 0.8, 1.0])
+def test_resampled_flag_follows_the_threshold_over_a_run(rho):
+    grid = room()
+    n = 300
+    pf = build(ParticleFilter, grid, seed=7, n_particles=n, rho=rho)
+    rng = np.random.default_rng(8)
+    pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
+    flags = []
+    for step in range(60):
+        found = detection(*rng.normal([1.5, 2.0], 0.1)) if step % 3 else None
+        belief = pf.update(DT, PURSUER, found, disc(grid, (1.5 + 0.02 * step, 2.0), 1.0))
+        assert belief.resampled == (belief.n_eff < rho * n)
+        flags.append(belief.resampled)
+    if rho == 0.0:
+        assert not any(flags)
+    if rho == 1.0:  # a detection always leaves the weights unequal, so N_eff < N
+        assert all(flag for step, flag in enumerate(flags) if step % 3)
+
+
+@pytest.mark.parametrize("scheme", ["systematic", "stratified", "multinomial"])
+def test_resamplers_match_filterpy(scheme, monkeypatch):
+    weights = np.random.default_rng(9).random(200) ** 3
+    weights /= weights.sum()
+    monkeypatch.setattr(filterpy_resampling, "random", np.random.default_rng(10).random)
+    theirs = getattr(filterpy_resampling, f"{scheme}_resample")(weights)
+    ours = resample(weights, scheme, np.random.default_rng(10))
+    np.testing.assert_array_equal(ours, theirs)
+
+
+def test_residual_resampler_keeps_filterpy_deterministic_copies(monkeypatch):
+    weights = np.random.default_rng(11).random(200) ** 3
+    weights /= weights.sum()
+    monkeypatch.setattr(filterpy_resampling, "random", np.random.default_rng(12).random)
+    theirs = filterpy_resampling.residual_resample(weights)
+    ours = resample(weights, "residual", np.random.default_rng(12))
+    copies = int(np.floor(200 * weights).sum())
+    np.testing.assert_array_equal(ours[:copies], theirs[:copies])
+
+
+@pytest.mark.parametrize("scheme", RESAMPLERS)
+def test_resamplers_are_unbiased_and_skip_zero_weights(scheme):
+    weights = np.array([0.1, 0.0, 0.25, 0.3, 0.35, 0.0])
+    rng = np.random.default_rng(13)
+    counts = np.zeros(weights.size)
+    for _ in range(4000):
+        drawn = np.bincount(resample(weights, scheme, rng), minlength=weights.size)
+        if scheme == "residual":
+            assert np.all(drawn >= np.floor(weights.size * weights))
+        counts += drawn
+    assert np.all(counts[weights == 0] == 0)
+    np.testing.assert_allclose(counts / 4000, weights.size * weights, atol=0.05)
+
+
+def test_systematic_round_off_edge_case(monkeypatch):
+    """Weights summing to 1 - 1e-12 and the largest uniform draw below 1: the last
+    position lies above the cumulative sum, which runs filterpy past the end."""
+    n = 10
+    weights = np.random.default_rng(14).random(n)
+    weights *= (1.0 - 1e-12) / weights.sum()
+    top = Constant(np.nextafter(1.0, 0.0))
+    monkeypatch.setattr(filterpy_resampling, "random", top.random)
+    with pytest.raises(IndexError):
+        filterpy_resampling.systematic_resample(weights)
+    indices = resample(weights, "systematic", top)
+    assert indices.shape == (n,) and indices.min() >= 0 and indices.max() == n - 1
+    trailing = np.append(weights[:-1], 0.0)  # a zero last weight must not catch the overflow
+    assert resample(trailing, "systematic", top).max() == n - 2
+
+
+def test_vanished_weights_reinitialise_outside_the_view(caplog):
+    grid = room()
+    pf = build(ParticleFilter, grid, seed=15, miss_factor=0.0)
+    pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.5))
+    view = disc(grid, (1.5, 2.0), 1.5)  # holds every particle, and the evader is not seen
+    with caplog.at_level(logging.INFO, logger=LOGGER):
+        belief = pf.update(DT, PURSUER, None, view)
+    assert "vanished" in caplog.text
+    assert belief.resampled and belief.n_eff == 0.0
+    assert np.all(np.isfinite(belief.particles)) and np.all(np.isfinite(belief.mean))
+    assert np.all(belief.weights == 1.0 / 2000)
+    assert np.all(on_free(grid, belief.particles))
+    assert not np.any(cell_values(grid, belief.particles, view))
+    everywhere = np.ones((grid.height, grid.width), dtype=bool)  # nothing left unseen
+    pf.reset(PURSUER, detection(1.5, 2.0), everywhere)
+    belief = pf.update(DT, PURSUER, None, everywhere)
+    assert np.all(on_free(grid, belief.particles)) and np.all(np.isfinite(belief.weights))
+
+
+def test_a_detection_far_from_every_particle_redraws_around_it(caplog):
+    grid = room()
+    pf = build(ParticleFilter, grid, seed=16)
+    pf.reset(PURSUER, detection(1.0, 1.0), disc(grid, (1.0, 1.0), 1.0))
+    with caplog.at_level(logging.INFO, logger=LOGGER):
+        belief = pf.update(DT, PURSUER, detection(4.2, 3.2), disc(grid, (4.2, 3.2), 1.0))
+    assert "lost the track" in caplog.text
+    assert math.dist(belief.mean, (4.2, 3.2)) < 0.3
+
+
+def test_no_weight_remains_on_blocked_cells():
+    grid = room()
+    pf = build(ParticleFilter, grid, seed=17, init_spread=1.0, rho=0.5)
+    near_wall = (2.9, 2.0)  # 0.1 m left of the block
+    view = disc(grid, near_wall, 1.0)
+    belief = pf.reset(PURSUER, detection(*near_wall), view)
+    assert np.all(on_free(grid, belief.particles))
+    rng = np.random.default_rng(18)
+    for step in range(40):
+        found = detection(*rng.normal(near_wall, 0.1)) if step % 2 else None
+        belief = pf.update(DT, PURSUER, found, view)
+        assert np.all(belief.weights[~on_free(grid, belief.particles)] == 0)
+        if belief.resampled:
+            assert np.all(on_free(grid, belief.particles))
+
+
+def test_detection_inside_an_obstacle_starts_on_free_cells(caplog):
+    grid = room()
+    pf = build(ParticleFilter, grid, seed=19)
+    inside = (3.25, 2.0)  # the middle of the block
+    with caplog.at_level(logging.INFO, logger=LOGGER):
+        belief = pf.reset(PURSUER, detection(*inside), disc(grid, inside, 1.0))
+    assert "blocked cell" in caplog.text
+    assert np.all(on_free(grid, belief.particles))
+    assert math.dist(belief.mean, inside) < 1.0
+    off_map = pf.reset(PURSUER, detection(-3.0, 2.0), disc(grid, (0.5, 2.0), 1.0))
+    assert np.all(on_free(grid, off_map.particles))
+
+
+def test_reset_without_detection_covers_the_visible_free_cells():
+    grid = room()
+    pf = build(ParticleFilter, grid, seed=20)
+    view = disc(grid, (3.0, 2.0), 1.0)  # straddles the block
+    belief = pf.reset(PURSUER, None, view)
+    assert np.all(cell_values(grid, belief.particles, view & grid.free))
+    nothing = np.zeros((grid.height, grid.width), dtype=bool)
+    belief = pf.reset(PURSUER, None, nothing)
+    assert np.all(on_free(grid, belief.particles))
+    assert np.ptp(belief.particles[:, 0]) > 3.5  # spread over the whole room
+
+
+def test_belief_layout_and_determinism():
+    grid = room()
+    runs = []
+    for seed in (21, 21, 22):
+        pf = build(ParticleFilter, grid, seed=seed, n_particles=100)
+        pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
+        runs.append(pf.update(DT, PURSUER, detection(1.6, 2.0), disc(grid, (1.5, 2.0), 1.0)))
+    belief = runs[0]
+    assert isinstance(belief.mean, tuple) and all(type(v) is float for v in belief.mean)
+    assert belief.covariance.shape == (2, 2)
+    np.testing.assert_allclose(belief.covariance, belief.covariance.T)
+    assert np.all(np.linalg.eigvalsh(belief.covariance) >= 0)
+    assert belief.particles.shape == (100, 3) and belief.weights.shape == (100,)
+    theta = belief.particles[:, 2]
+    assert np.all((theta > -math.pi) & (theta <= math.pi))
+    np.testing.assert_array_equal(runs[0].particles, runs[1].particles)
+    assert not np.array_equal(runs[0].particles, runs[2].particles)
+
+
+def test_visibility_mask_of_the_wrong_shape_is_rejected():
+    grid = room()
+    pf = build(ParticleFilter, grid, n_particles=10)
+    with pytest.raises(ValueError, match="shape"):
+        pf.reset(PURSUER, None, np.ones((3, 3), dtype=bool))
+
+
+# --------------------------------------------------------------------------- kalman
+
+
+def straight_track(ticks, start=(1.0, 1.0), velocity=(0.3, 0.2)):
+    """True positions (ticks, 2) of a constant-velocity target sampled every DT s."""
+    return np.asarray(start) + np.outer(np.arange(ticks) * DT, velocity)
+
+
+def test_kalman_converges_on_a_constant_velocity_track():
+    grid = room()
+    kf = build(KalmanEstimator, grid)
+    truth = straight_track(40)
+    noise = np.random.default_rng(23).normal(0.0, 0.1, truth.shape)
+    belief = kf.reset(PURSUER, detection(*(truth[0] + noise[0])), None)
+    errors = []
+    for k in range(1, 40):
+        belief = kf.update(DT, PURSUER, detection(*(truth[k] + noise[k])), None)
+        errors.append(math.dist(belief.mean, truth[k]))
+    assert max(errors[29:]) < 0.2
+    assert belief.covariance.shape == (2, 2)
+
+
+def test_kalman_coasts_through_a_gap_of_misses():
+    grid = room()
+    kf = build(KalmanEstimator, grid)
+    truth = straight_track(45)
+    noise = np.random.default_rng(24).normal(0.0, 0.1, truth.shape)
+    kf.reset(PURSUER, detection(*(truth[0] + noise[0])), None)
+    for k in range(1, 35):
+        seen = kf.update(DT, PURSUER, detection(*(truth[k] + noise[k])), None)
+    for k in range(35, 45):
+        belief = kf.update(DT, PURSUER, None, None)
+    assert math.dist(belief.mean, truth[44]) < 0.2
+    assert math.dist(belief.mean, seen.mean) > 0.3  # it moved along the track
+    assert np.trace(belief.covariance) > np.trace(seen.covariance)
+
+
+def test_kalman_waits_for_a_detection_and_clamps_the_speed():
+    grid = room()
+    kf = build(KalmanEstimator, grid)
+    assert kf.reset(PURSUER, None, None).mean is None
+    assert kf.update(DT, PURSUER, None, None).mean is None
+    assert kf.update(DT, PURSUER, detection(1.0, 1.0), None).mean == (1.0, 1.0)
+    for k in range(1, 20):  # detections moving at 3 m/s, six times the evader's v_max
+        kf.update(DT, PURSUER, detection(1.0 + 0.3 * k, 1.0), None)
+        assert math.hypot(*kf._kf.x[2:4]) <= 0.5 + 1e-12
+
+
+# --------------------------------------------------------------------------- last seen
+
+
+def test_last_seen_holds_the_last_detection():
+    grid = room()
+    estimator = build(LastSeen, grid)
+    assert estimator.reset(PURSUER, None, None).mean is None
+    for position in straight_track(10):
+        belief = estimator.update(DT, PURSUER, detection(*position), None)
+        assert belief.mean == tuple(position)
+    for _ in range(5):
+        assert estimator.update(DT, PURSUER, None, None).mean == tuple(position)
