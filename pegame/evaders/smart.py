@@ -20,6 +20,13 @@ evader's over the cells traversable for its radius and the pursuer's over the ce
 traversable for the pursuer's radius (``context.pursuer.radius``). A candidate the
 pursuer cannot reach has cost_dist = +inf and so cost 0: an ideal hiding place.
 
+Hidden means the whole body: with ``hide_margin`` > 0 (default 0.3 m, about the evader's
+radius) a candidate must lie more than that distance (cell centre to cell centre) from
+every cell of V. With the paper's bare cell test (``hide_margin=0``) the argmin is the
+free cell right next to V's edge; an evader whose centre stands in V arrives there within
+the follower's tolerance while still seen, and stays: measured on the enclosed map this
+froze every smart-vs-smart game at 100% tracking.
+
 Ties go to the lowest cost, then to the lowest row-major cell index (row * width + col),
 so the same inputs always give the same goal.
 
@@ -50,6 +57,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import distance_transform_edt
 
 from pegame.api import STOP, Evader, EvaderObservation, Plan, Pose, Velocity
 from pegame.errors import require
@@ -90,10 +98,12 @@ class SmartEvader(Evader):
     class Config(Evader.Config):
         distance: str = "euclidean"  # 'euclidean' (the paper) or 'geodesic' (grid paths)
         candidate_stride: int = 1  # score every k-th cell in rows and columns (k >= 1)
+        hide_margin: float = 0.3  # m; candidates lie at least this far outside V (the body hidden)
 
         def __post_init__(self) -> None:
             super().__post_init__()
             require(self.distance in DISTANCES, "evader.distance", ", ".join(DISTANCES), self.distance)
+            require(self.hide_margin >= 0, "evader.hide_margin", "a distance >= 0 m", self.hide_margin)
             require(
                 self.candidate_stride >= 1, "evader.candidate_stride", "an integer >= 1",
                 self.candidate_stride,
@@ -161,7 +171,11 @@ class SmartEvader(Evader):
         """Flat row-major indices (row * width + col, increasing) of the candidate cells:
         reachable by the evader at ``me``, outside the visibility region of the pursuer at
         ``pursuer``, and on the candidate stride."""
-        visible = visibility_region(self.context.grid, pursuer, self.context.camera)
+        grid = self.context.grid
+        visible = visibility_region(grid, pursuer, self.context.camera)
+        if self.config.hide_margin > 0 and visible.any():
+            # Hidden means the whole body is out of view, not only its centre's cell.
+            visible = distance_transform_edt(~visible) * grid.resolution <= self.config.hide_margin
         mask = self.planner.reachable((me.x, me.y)) & ~visible & self._strided
         return np.flatnonzero(mask)
 

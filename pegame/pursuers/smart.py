@@ -13,9 +13,11 @@ axis) and turned into a turn rate w = -k_w * u (rad/s, map frame CCW positive, s
 evader on the right makes the robot turn clockwise). The forward speed follows the
 detection's depth (m, along the optical axis): v = k_v * (depth - standoff) (m/s), so
 the robot approaches a far evader and backs off from a near one. Both are saturated to
-the body's limits, and v is set to 0 when the straight motion over a short look-ahead
-would enter the pursuer's inflated obstacle cells (``inflate(grid, radius)``, the
-simulator's collision mask of the robot's centre).
+the body's limits. When the straight motion over a short look-ahead would enter the
+pursuer's inflated obstacle cells (``inflate(grid, radius)``, the simulator's collision
+mask of the robot's centre), backing off stops (v = 0) and approaching becomes a detour:
+the pursuer follows a planned path to the detected position, as move_base would, instead
+of standing at the corner that its line of sight grazes.
 
 Searching (no detection): the pursuer plans from its pose to the estimator's estimate,
 the weighted mean of the particles (``observation.belief.mean``, map frame, m), and
@@ -111,8 +113,18 @@ class SmartPursuer(Pursuer):
         v = _clamp(self.config.k_v * (detection.depth - self.config.standoff), body.v_max)
         reach = math.copysign(max(abs(v) * LOOKAHEAD_TIME, body.radius), v)
         if v != 0.0 and not self._clear(observation.pose, reach):
-            v = 0.0
+            return self._detour(observation, w) if v > 0 else Velocity(0.0, w)
         return Velocity(v, w)
+
+    def _detour(self, observation: PursuerObservation, w: float) -> Velocity:
+        """Approaching is blocked (the line of sight grazes an obstacle): follow a planned
+        path to the detected position instead, as move_base would; turn in place if none."""
+        pose, target = observation.pose, observation.detection.position
+        result = self.planner.plan((pose.x, pose.y), target)
+        if not result.reachable:
+            return Velocity(0.0, w)
+        self.follower.set_path(result.path)
+        return self.follower.command(pose)
 
     def _clear(self, pose: Pose, distance: float) -> bool:
         """True when moving ``distance`` m straight along the heading (negative: backwards)
