@@ -1,9 +1,10 @@
 """The Hydra app: ``python -m pegame [overrides]`` (also the ``pegame`` console script).
 
-Plays one game with the composed config and writes into Hydra's run directory:
-``.hydra/`` (the composed config), ``trajectory.csv``, ``result.json`` (last, atomically)
-and ``pegame.log``. A bad config, map or plugin name is reported as one paragraph with a
-non-zero exit status and no traceback (set HYDRA_FULL_ERROR=1 for one).
+Plays ``game.trials`` games (one by default) with the composed config in Hydra's run
+directory (see :mod:`pegame.job` for the files). In a multirun sweep (``-m``) the
+recorder is off unless ``recorder=...`` is given on the command line. A bad config, map
+or plugin name is reported as one paragraph with exit status 2 and no traceback (set
+HYDRA_FULL_ERROR=1 for one).
 """
 
 from __future__ import annotations
@@ -11,12 +12,12 @@ from __future__ import annotations
 import logging
 import os
 import sys
-import time
 
 import hydra
 from hydra.core.hydra_config import HydraConfig
+from hydra.types import RunMode
 from hydra.utils import get_original_cwd
-from omegaconf import DictConfig
+from omegaconf import DictConfig, OmegaConf, open_dict
 
 from pegame.config import register_schema
 from pegame.errors import PegameError
@@ -24,24 +25,22 @@ from pegame.errors import PegameError
 log = logging.getLogger("pegame")
 
 
-def run(cfg: DictConfig) -> dict:
-    """Play the configured game in Hydra's output directory; return its result."""
-    from pegame.game import Game, summary_line, write_outcome
-
-    out_dir = HydraConfig.get().runtime.output_dir
-    started = time.perf_counter()
-    game = Game(cfg, base_dir=get_original_cwd())
-    outcome = game.play(out_dir)
-    write_outcome(outcome, out_dir)
-    log.info("played in %.2f s wall time; outputs in %s", time.perf_counter() - started, out_dir)
-    print(summary_line(outcome.result))
-    return outcome.result
+def sweep_defaults(cfg: DictConfig) -> None:
+    """In a multirun, turn the recorder off unless the command line chose one."""
+    hydra_cfg = HydraConfig.get()
+    chosen = any(o.split("=", 1)[0].lstrip("+~") == "recorder" for o in hydra_cfg.overrides.task)
+    if hydra_cfg.mode == RunMode.MULTIRUN and not chosen and cfg.recorder.name != "none":
+        with open_dict(cfg):
+            cfg.recorder = OmegaConf.create({"name": "none"})
 
 
 @hydra.main(version_base=None, config_path="pkg://pegame.conf", config_name="config")
 def _app(cfg: DictConfig) -> None:
+    from pegame.job import run_job
+
     try:
-        run(cfg)
+        sweep_defaults(cfg)
+        run_job(cfg, HydraConfig.get().runtime.output_dir, base_dir=get_original_cwd())
     except PegameError as exc:
         if os.environ.get("HYDRA_FULL_ERROR") == "1":
             raise

@@ -32,9 +32,11 @@ class GameConfig:
     control_hz: float = 10.0  # control rate: integration, sensing, commands (Hz)
     decision_hz: float = 1.0  # decision rate of both strategies (Hz); the paper's 1 Hz
     speed_ratio: float = 1.0  # pursuer max speed / evader max speed (v_p / v_e)
+    trials: int = 1  # games in one job, with seeds seed, seed + 1, ...
 
     def __post_init__(self) -> None:
         require(self.t_max > 0, "game.t_max", "a positive duration in seconds", self.t_max)
+        require(self.trials >= 1, "game.trials", "a whole number >= 1", self.trials)
         for key in ("control_hz", "decision_hz", "speed_ratio"):
             value = getattr(self, key)
             require(value > 0 and math.isfinite(value), f"game.{key}", "a positive number", value)
@@ -77,6 +79,7 @@ class Schema:
     pursuer: Any = MISSING
     evader: Any = MISSING
     recorder: Any = MISSING
+    resume: bool = False  # skip games already stored in the job's results.jsonl
 
 
 def register_schema() -> None:

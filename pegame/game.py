@@ -130,8 +130,8 @@ class Game:
         }
         self.config = OmegaConf.to_container(cfg, resolve=True)
 
-    def play(self, out_dir: str | Path) -> Outcome:
-        """Play the game; the recorder (if any) writes into ``out_dir``."""
+    def play(self, out_dir: str | Path, recording_name: str = "game") -> Outcome:
+        """Play the game; the recorder (if any) writes ``recording_name`` into ``out_dir``."""
         sim, detector, estimator = self.plugins["sim"], self.plugins["detector"], self.plugins["estimator"]
         pursuer, evader, recorder = self.plugins["pursuer"], self.plugins["evader"], self.plugins["recorder"]
         grid, camera, dt = self.context.grid, self.camera, self.context.control_dt
@@ -143,7 +143,7 @@ class Game:
         detector.reset()
         pursuer.reset(start_p)
         evader.reset(start_e)
-        recorder.start(str(out_dir), f"seed{self.settings.seed}", self.config)
+        recorder.start(str(out_dir), recording_name, self.config)
         metrics = TrackingMetrics(dt)
         trajectory: list[tuple] = []
         p_plan = e_plan = Plan()
