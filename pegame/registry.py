@@ -78,7 +78,7 @@ def load(group: str, name: str) -> type:
     point = entry_point(group, name)
     try:
         cls = point.load()
-    except ImportError as exc:
+    except (ImportError, AttributeError) as exc:
         missing = getattr(exc, "name", None)
         hint = (
             f" It needs the package '{missing}': install it (pip install {missing}) or "

@@ -1,0 +1,309 @@
+"""The Rerun recorder, replay and the trajectory figure.
+
+Recordings are read back with Rerun's own tools: ``rerun rrd verify`` and the chunk
+reader of rerun-sdk (``rerun.chunk.RrdReader``), counting each entity's rows on the
+``step`` timeline.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import subprocess
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from pegame.api import (
+    Belief,
+    Body,
+    BoundingBox,
+    Camera,
+    Context,
+    Detection,
+    Plan,
+    Pose,
+    SensorFrame,
+    Tick,
+    Velocity,
+)
+from pegame.figures import plot_trajectory
+from pegame.game import Game
+from pegame.geometry import visibility_region
+from pegame.maps import OccupancyGrid
+from pegame.recording import RerunRecorder, recording_id, visibility_outline
+from pegame.replay import find_recordings, main as replay_main, viewer_command
+
+SHORT = ["game.t_max=5", "env=hall"]
+TICKS = 50  # 5 s at the default 10 Hz
+PER_TICK = [
+    "/world/pursuer/pose", "/world/pursuer/heading", "/world/pursuer/fov",
+    "/world/pursuer/visible", "/world/evader/pose", "/world/evader/heading",
+    "/world/detection", "/world/belief/mean", "/camera/detection",
+    "/plots/tracking/detected", "/plots/tracking/rate", "/plots/distance/true",
+]
+STATIC = ["/world", "/world/map", "/camera/frame", "/config", "/__properties/config", "/__properties/result"]
+
+
+def read_steps(path: Path) -> tuple[dict[str, list[int]], set[str], list]:
+    """(steps per temporal entity, static entities, blueprint stores) of an .rrd file."""
+    from rerun.chunk import RrdReader
+
+    reader = RrdReader(path)
+    steps: dict[str, list[int]] = defaultdict(list)
+    static: set[str] = set()
+    for chunk in reader.stream().to_chunks():
+        if chunk.is_static:
+            static.add(chunk.entity_path)
+        else:
+            steps[chunk.entity_path].extend(chunk.to_record_batch().column("step").to_pylist())
+    return steps, static, reader.blueprints()
+
+
+@pytest.fixture(scope="module")
+def played(tmp_path_factory):
+    """A 5 s game on the hall map recorded with recorder=rerun: (game, outcome, out_dir)."""
+    from hydra import compose, initialize_config_module
+
+    from pegame.config import register_schema
+
+    register_schema()
+    with initialize_config_module(config_module="pegame.conf", version_base=None):
+        cfg = compose(config_name="config", overrides=["recorder=rerun", *SHORT])
+    out_dir = tmp_path_factory.mktemp("run")
+    game = Game(cfg)
+    return game, game.play(out_dir), out_dir
+
+
+def test_one_recording_per_game_named_after_it(played):
+    _, _, out_dir = played
+    assert sorted(p.name for p in out_dir.glob("*.rrd")) == ["game.rrd"]
+
+
+def test_rerun_verifies_the_recording(played):
+    _, _, out_dir = played
+    proc = subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(out_dir / "game.rrd")],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_entities_have_one_row_per_step(played):
+    _, outcome, out_dir = played
+    steps, static, blueprints = read_steps(out_dir / "game.rrd")
+    assert outcome.result["ticks"] == TICKS
+    for entity in PER_TICK:
+        assert steps[entity] == list(range(TICKS)), entity
+    assert set(STATIC) <= static
+    # trajectories every trail_every (5) ticks and at the end
+    for entity in ("/world/pursuer/trajectory", "/world/evader/trajectory"):
+        assert steps[entity] == [*range(0, TICKS, 5), TICKS - 1], entity
+    # decision ticks only (1 Hz of 10 Hz control): paths and goals of both strategies
+    for entity in ("/world/pursuer/path", "/world/evader/goal"):
+        assert 1 <= len(steps[entity]) <= TICKS // 10 + 1, entity
+    assert steps["/events"], "the start of tracking is an event"
+    assert len(blueprints) == 1
+
+
+def test_recording_does_not_change_the_game(played, compose_config, tmp_path):
+    _, outcome, _ = played
+    plain = Game(compose_config(["recorder=none", *SHORT])).play(tmp_path)
+    assert plain.result == outcome.result
+    assert plain.trajectory == outcome.trajectory
+    assert not list(tmp_path.glob("*.rrd"))
+
+
+def test_unwritable_output_dir_warns_and_the_game_goes_on(played, compose_config, tmp_path):
+    _, outcome, _ = played
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a directory")
+    with pytest.warns(RuntimeWarning, match="Rerun recording .* disabled"):
+        result = Game(compose_config(["recorder=rerun", *SHORT])).play(blocker / "run").result
+    assert result == outcome.result
+
+
+# ------------------------------------------------------------ the recorder alone
+
+
+def small_context() -> Context:
+    data = np.zeros((60, 80), dtype=np.int8)
+    data[:, :2] = data[:, -2:] = data[:2, :] = data[-2:, :] = 100
+    data[20:40, 50:52] = 100
+    grid = OccupancyGrid(data, 0.1, origin=(-1.0, 2.0, 0.3), name="box")
+    return Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
+
+
+def synthetic_ticks(context: Context, count: int) -> list[Tick]:
+    """Ticks with particles, weights, N_eff, candidates, a mode and a lost detection."""
+    rng = np.random.default_rng(1)
+    ticks = []
+    plans = {}
+    for step in range(count):
+        pursuer = Pose(1.0 + 0.05 * step, 4.5, 0.2)
+        evader = Pose(3.5, 4.0 + 0.02 * step, 1.0)
+        detection = None
+        if step < 4 or step >= 8:
+            detection = Detection(BoundingBox(300, 200, 40, 90), 2.5, (evader.x, evader.y), 0.9)
+        particles = np.column_stack([rng.normal(3.5, 0.3, (1000, 2)), rng.uniform(-3, 3, 1000)])
+        weights = rng.random(1000)
+        belief = Belief((3.4, 4.1), particles=particles, weights=weights / weights.sum(), n_eff=700.0)
+        decision = step // 5  # a new plan every 5 ticks, the same objects in between
+        if decision not in plans:
+            plans[decision] = (
+                Plan(goal=(2.0 + decision, 4.0), path=np.array([[1.0, 4.5], [2.0 + decision, 4.0]]),
+                     info={"mode": "track" if decision % 2 == 0 else "search"}),
+                Plan(goal=(4.0, 5.0), path=np.array([[3.5, 4.0], [4.0, 5.0]]),
+                     info={"candidates": np.array([[4.0, 5.0], [5.0, 3.0], [2.0 + decision, 6.0]])}),
+            )
+        visible = visibility_region(context.grid, pursuer, context.camera)
+        ticks.append(Tick(step, 0.1 * step, pursuer, evader, SensorFrame(0.1 * step, pursuer), detection,
+                          belief, visible, detection is not None, (Velocity(), Velocity()), plans[decision]))
+    return ticks
+
+
+def test_recorder_logs_particles_candidates_n_eff_and_events(tmp_path):
+    context = small_context()
+    ticks = synthetic_ticks(context, 23)
+    recorder = RerunRecorder(RerunRecorder.Config(flush_every=10, max_particles=100), context, None)
+    recorder.start(str(tmp_path), "game_7", {"pursuer": {"name": "smart"}, "game": {"seed": 7}})
+    for tick in ticks:
+        recorder.log(tick)
+    recorder.finish({"tracking_rate": 0.8, "mean_estimation_error": None})
+    steps, static, _ = read_steps(tmp_path / "game_7.rrd")
+    every = list(range(23))
+    for entity in ("/world/belief/particles", "/plots/n_eff", "/plots/distance/estimate_error", "/world/detection"):
+        assert steps[entity] == every, entity
+    # a new plan every 5 ticks; candidates only then
+    assert steps["/world/evader/candidates"] == [0, 5, 10, 15, 20]
+    # start, lost at 4, reacquired at 8, pursuer modes at 0, 5, 10, 15, 20, game over at 22
+    assert sorted(steps["/events"]) == [0, 0, 4, 5, 8, 10, 15, 20, 22]
+    assert "/__properties/result" in static
+
+
+def test_spawn_sends_live_to_a_viewer_as_well_as_to_the_file(monkeypatch, tmp_path):
+    import rerun as rr
+
+    spawned = []
+    monkeypatch.setattr(rr, "spawn", lambda **kwargs: spawned.append(kwargs))
+    # No screen here: the viewer's gRPC sink is replaced by a second file.
+    monkeypatch.setattr(rr, "GrpcSink", lambda: rr.FileSink(str(tmp_path / "live.rrd")))
+    context = small_context()
+    ticks = synthetic_ticks(context, 12)
+    for spawn in (False, True):
+        recorder = RerunRecorder(RerunRecorder.Config(spawn=spawn), context, None)
+        recorder.start(str(tmp_path), "game", {})
+        for tick in ticks:
+            recorder.log(tick)
+        recorder.finish({})
+        assert spawned == ([{"connect": False}] if spawn else [])
+    live, _, _ = read_steps(tmp_path / "live.rrd")
+    assert live["/world/pursuer/pose"] == list(range(12))
+
+
+def test_bad_recorder_options_are_config_errors():
+    from pegame.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="recorder.flush_every"):
+        RerunRecorder.Config(flush_every=0)
+    with pytest.raises(ConfigError, match="recorder.jpeg_quality"):
+        RerunRecorder.Config(jpeg_quality=101)
+
+
+def test_particles_are_subsampled_and_coloured_by_weight(tmp_path):
+    from rerun.chunk import RrdReader
+
+    context = small_context()
+    recorder = RerunRecorder(RerunRecorder.Config(max_particles=100), context, None)
+    recorder.start(str(tmp_path), "game", {})
+    tick = synthetic_ticks(context, 1)[0]
+    particles_before = tick.belief.particles.copy()
+    recorder.log(tick)
+    recorder.finish({})
+    assert np.array_equal(tick.belief.particles, particles_before)
+    chunks = [c for c in RrdReader(tmp_path / "game.rrd").stream().to_chunks()
+              if c.entity_path == "/world/belief/particles" and not c.is_static]
+    batch = chunks[0].to_record_batch()
+    positions = batch.column("Points3D:positions").to_pylist()[0]
+    colors = batch.column("Points3D:colors").to_pylist()[0]
+    assert len(positions) == len(colors) == 100
+    assert len(set(colors)) > 10
+
+
+def test_recording_id_is_deterministic_per_place_and_config(tmp_path):
+    config = {"game": {"seed": 3}}
+    assert recording_id(tmp_path, "game", config) == recording_id(tmp_path, "game", dict(config))
+    assert recording_id(tmp_path, "game", config) != recording_id(tmp_path / "other", "game", config)
+    assert recording_id(tmp_path, "game", config) != recording_id(tmp_path, "game", {"game": {"seed": 4}})
+
+
+def test_visibility_outline_matches_its_reference_and_bounds_the_mask():
+    context = small_context()
+    grid, camera = context.grid, context.camera
+    for pose in (Pose(1.0, 4.5, 0.2), Pose(3.0, 5.0, -2.5), Pose(4.5, 4.0, 0.1)):
+        mask = visibility_region(grid, pose, camera)
+        fast = visibility_outline(mask, grid, pose, camera, 64, z=0.01)
+        slow = visibility_outline(mask, grid, pose, camera, 64, z=0.01, compiled=False)
+        np.testing.assert_array_equal(fast, slow)
+        assert fast.shape == (129, 3) and np.array_equal(fast[0], fast[-1])
+        reach = np.hypot(fast[:64, 0] - pose.x, fast[:64, 1] - pose.y)
+        assert np.all(reach >= camera.near - 1e-4) and np.all(reach <= camera.far + 1e-4)
+        # the far ends lie in visible cells (float32 rounding may move one across a cell edge)
+        rows, cols = grid.world_to_cell(fast[:64, 0], fast[:64, 1])
+        beyond_near = reach > camera.near + 1e-4
+        assert beyond_near.any() and mask[rows[beyond_near], cols[beyond_near]].mean() > 0.95
+
+
+def test_config_file_lists_every_field_with_its_default():
+    conf = Path(__file__).resolve().parents[1] / "conf" / "recorder" / "rerun.yaml"
+    values = yaml.safe_load(conf.read_text())
+    defaults = {f.name: f.default for f in dataclasses.fields(RerunRecorder.Config)}
+    assert values == {"name": "rerun", **defaults}
+
+
+def test_importing_the_recorders_does_not_import_rerun():
+    code = "import sys, pegame.recording; print('rerun' in sys.modules)"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
+
+
+# ------------------------------------------------------------------------ replay
+
+
+def test_replay_finds_recordings_recursively_sorted(tmp_path, capsys):
+    for name in ("job1/game_2.rrd", "job0/game_1.rrd", "job0/game_0.rrd"):
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_bytes(b"x" * 1500)
+    files = find_recordings(tmp_path)
+    assert [p.relative_to(tmp_path).as_posix() for p in files] == ["job0/game_0.rrd", "job0/game_1.rrd", "job1/game_2.rrd"]
+    assert viewer_command(files)[:3] == [sys.executable, "-m", "rerun"]
+    assert replay_main([str(tmp_path), "--list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines == [f"{p}  1.5 kB" for p in files]
+
+
+def test_replay_without_recordings_is_a_clear_error(tmp_path, capsys):
+    assert replay_main([str(tmp_path)]) == 2
+    assert "No Rerun recordings (*.rrd)" in capsys.readouterr().err
+    assert replay_main([str(tmp_path / "missing")]) == 2
+    assert "is not a directory" in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------------- figures
+
+
+def test_plot_trajectory_writes_a_png(played, tmp_path):
+    game, outcome, _ = played
+    path = plot_trajectory(game.context.grid, outcome.trajectory, tmp_path / "trajectory.png",
+                           pairing=outcome.result["pairing"], tracking_rate=outcome.result["tracking_rate"])
+    data = path.read_bytes()
+    assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 10_000
+    assert not [p for p in tmp_path.iterdir() if p.name != "trajectory.png"], "no temporary file left"
+
+
+def test_plot_trajectory_takes_csv_text_and_a_rotated_map(tmp_path):
+    grid = small_context().grid
+    rows = [[str(v) for v in (k, 0.1 * k, 1 + 0.1 * k, 4.5, 0.0, 3.5, 4 + math.sin(k), 1.0, 1, 1)] for k in range(20)]
+    path = plot_trajectory(grid, rows, tmp_path / "trajectory.png", title="S-R (smart vs random) on box: " * 3)
+    assert path.stat().st_size > 1000
