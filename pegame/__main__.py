@@ -26,12 +26,17 @@ log = logging.getLogger("pegame")
 
 
 def sweep_defaults(cfg: DictConfig) -> None:
-    """In a multirun, turn the recorder off unless the command line chose one."""
+    """In a multirun, turn the recorder off unless the command line chose one; never open
+    a live viewer per game when a run plays several games."""
     hydra_cfg = HydraConfig.get()
+    multirun = hydra_cfg.mode == RunMode.MULTIRUN
     chosen = any(o.split("=", 1)[0].lstrip("+~") == "recorder" for o in hydra_cfg.overrides.task)
-    if hydra_cfg.mode == RunMode.MULTIRUN and not chosen and cfg.recorder.name != "none":
-        with open_dict(cfg):
+    with open_dict(cfg):
+        if multirun and not chosen and cfg.recorder.name != "none":
             cfg.recorder = OmegaConf.create({"name": "none"})
+        if (multirun or cfg.game.trials > 1) and cfg.recorder.get("spawn", False):
+            log.warning("recorder.spawn ignored: this run plays several games")
+            cfg.recorder.spawn = False
 
 
 @hydra.main(version_base=None, config_path="pkg://pegame.conf", config_name="config")

@@ -17,6 +17,7 @@ import json
 import logging
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +48,21 @@ log = logging.getLogger(__name__)
 #: the order in which components draw their generators from the master seed; append only
 STREAMS = ("spawn", "sim", "detector", "estimator", "pursuer", "evader", "recorder")
 PLUGIN_GROUPS = ("sim", "detector", "estimator", "pursuer", "evader", "recorder")
+
+
+def cached_map(path: Path) -> OccupancyGrid:
+    """The map at ``path``, loaded once per process while the file is unchanged: grids
+    are immutable, so the games of a job share one (and the planners cached on it)."""
+    try:
+        stamp = path.stat().st_mtime_ns
+    except OSError:
+        return load_map(path)  # raises the MapError that names the missing file
+    return _load_map_once(str(path), stamp)
+
+
+@lru_cache(maxsize=8)
+def _load_map_once(path: str, stamp: int) -> OccupancyGrid:
+    return load_map(path)
 
 
 def pairing(pursuer: str, evader: str) -> str:
@@ -104,7 +120,7 @@ class Game:
         self.camera: Camera = typed(cfg.camera, Camera, "camera")
         env: EnvConfig = typed(cfg.env, EnvConfig, "env")
         self.env_name = env.name
-        grid = load_map(resolve_map_path(env.map, base_dir))
+        grid = cached_map(resolve_map_path(env.map, base_dir))
         self.names = {group: str(cfg[group].name) for group in PLUGIN_GROUPS}
         classes = {group: registry.load(group, self.names[group]) for group in PLUGIN_GROUPS}
         configs = {
