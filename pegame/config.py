@@ -12,10 +12,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, make_dataclass
+from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any, Mapping, Sequence, get_type_hints
 
+from hydra.core.config_search_path import ConfigSearchPath
 from hydra.core.config_store import ConfigStore
+from hydra.core.plugins import Plugins
+from hydra.plugins.search_path_plugin import SearchPathPlugin
 from omegaconf import MISSING, DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
@@ -82,9 +86,22 @@ class Schema:
     resume: bool = False  # skip games already stored in the job's results.jsonl
 
 
+class PluginConfigSearchPath(SearchPathPlugin):
+    """Lets plugin distributions contribute config files: a distribution names the package
+    holding its ``<group>/<name>.yaml`` files under the entry-point group
+    ``pegame.configs`` (``spinner = "spinner.conf"``), and Hydra finds them as it finds
+    pegame's own, so ``python -m pegame pursuer=spinner`` needs no extra flag."""
+
+    def manipulate_search_path(self, search_path: ConfigSearchPath) -> None:
+        for point in sorted(entry_points(group="pegame.configs"), key=lambda p: p.name):
+            search_path.append(provider=f"pegame-plugin-{point.name}", path=f"pkg://{point.value}")
+
+
 def register_schema() -> None:
-    """Make the schema available to config.yaml's defaults list as ``pegame_schema``."""
+    """Make the schema available to config.yaml's defaults list as ``pegame_schema`` and
+    add the plugin distributions' config packages to Hydra's search path."""
     ConfigStore.instance().store(name="pegame_schema", node=Schema)
+    Plugins.instance().register(PluginConfigSearchPath)
 
 
 def resolve_map_path(map_path: str, base_dir: str | Path | None = None) -> Path:

@@ -65,9 +65,14 @@ def _load_map_once(path: str, stamp: int) -> OccupancyGrid:
     return load_map(path)
 
 
+#: the paper's letters for its agents; other strategies appear by name in pairings
+PAPER_LETTERS = {"random": "R", "smart": "S"}
+
+
 def pairing(pursuer: str, evader: str) -> str:
-    """The paper's pairing label, e.g. 'S-R' for a smart pursuer and a random evader."""
-    return f"{pursuer[:1].upper()}-{evader[:1].upper()}"
+    """The paper's pairing label, e.g. 'S-R' for a smart pursuer and a random evader
+    ('policy-S' for a pursuer named policy)."""
+    return f"{PAPER_LETTERS.get(pursuer, pursuer)}-{PAPER_LETTERS.get(evader, evader)}"
 
 
 def spawn(context: Context, rng: np.random.Generator, attempts: int = 500) -> tuple[Pose, Pose]:
