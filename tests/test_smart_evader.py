@@ -6,17 +6,27 @@ import heapq
 import logging
 import math
 from collections import deque
+from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.ndimage import distance_transform_edt
 
 from pegame.api import Body, Camera, Context, EvaderObservation, Pose
 from pegame.errors import ConfigError
-from pegame.evaders.smart import MAX_RECORDED_CANDIDATES, SmartEvader
+from pegame.evaders.smart import (
+    MAX_RECORDED_CANDIDATES,
+    SmartEvader,
+    _grow,
+    _sample_positions,
+    disc_half_widths,
+)
 from pegame.geometry import visibility_region
-from pegame.maps import FREE, OCCUPIED, OccupancyGrid
+from pegame.maps import FREE, OCCUPIED, OccupancyGrid, load_map
 from pegame.navigation import Planner
 from pegame.registry import make_config
+
+MAPS_DIR = Path(__file__).resolve().parents[1] / "maps"
 
 RES = 0.1  # m per cell in every test grid
 CAMERA = Camera(fov=math.pi / 3, near=0.3, far=5.0, angle_step=0.004, distance_step=0.05)
@@ -139,15 +149,15 @@ def brute_argmin(cost: np.ndarray) -> tuple[int, int]:
     return best_cell
 
 
-def random_scene(seed: int):
-    """A 30 x 30 grid with random blocks, a pursuer pose and an evader pose (in view when
-    possible), both in cells traversable for their bodies."""
+def random_scene(seed: int, size: int = 30, n_blocks: int = 5):
+    """A size x size grid with random blocks, a pursuer pose and an evader pose (in view
+    when possible), both in cells traversable for their bodies."""
     rng = np.random.default_rng(seed)
     blocks = []
-    for _ in range(5):
-        r, c = rng.integers(3, 25, 2)
+    for _ in range(n_blocks):
+        r, c = rng.integers(3, size - 5, 2)
         blocks.append((r, r + rng.integers(1, 5), c, c + rng.integers(1, 5)))
-    grid = walled_grid(30, 30, blocks)
+    grid = walled_grid(size, size, blocks)
     p_rows, p_cols = np.nonzero(Planner(grid, PURSUER.radius).traversable)
     k = rng.integers(p_rows.size)
     pursuer = Pose(*centre(p_rows[k], p_cols[k]), rng.uniform(-math.pi, math.pi))
@@ -179,6 +189,86 @@ def test_goal_is_the_brute_force_argmin(distance, seed, margin):
     assert Planner(grid, EVADER.radius).reachable((me.x, me.y))[goal]
     assert plan.info["escape_cost"] == pytest.approx(cost[expected], rel=1e-9, abs=1e-12)
     assert len(plan.path) > 0
+
+
+def assert_same_escape(smart, me, pursuer):
+    """The fast escape equals the numpy reference exactly; returns it."""
+    fast, slow = smart.escape(me, pursuer), smart.escape_reference(me, pursuer)
+    assert (fast.cell, fast.cost, fast.count) == (slow.cell, slow.cost, slow.count)
+    np.testing.assert_array_equal(fast.sample, slow.sample)
+    return fast
+
+
+@pytest.mark.parametrize("distance", ["euclidean", "geodesic"])
+@pytest.mark.parametrize("margin, stride", [(0.0, 1), (0.15, 1), (0.3, 1), (0.3, 3)])
+def test_escape_kernels_match_the_numpy_reference(distance, margin, stride):
+    for seed in range(25):
+        # Small rooms, and larger ones where most tiles are out of view and skipped.
+        size, n_blocks = (30, 5) if seed % 2 else (90, 40)
+        grid, pursuer, me = random_scene(seed, size, n_blocks)
+        smart = make_evader(grid, distance, hide_margin=margin, candidate_stride=stride)
+        assert_same_escape(smart, me, pursuer)
+
+
+@pytest.mark.parametrize("distance", ["euclidean", "geodesic"])
+def test_escape_kernels_match_the_reference_on_a_paper_map(distance):
+    grid = load_map(MAPS_DIR / "enclosed.yaml")
+    camera, evader, pursuer_body = Camera(), Body(0.25, 0.5, 1.8), Body(0.2, 0.5, 1.8)
+    smart = make_evader(grid, distance, camera=camera, evader=evader, pursuer=pursuer_body)
+    rows, cols = np.nonzero(smart.planner.traversable)
+    rng = np.random.default_rng(31)
+    recorded = []
+    for k in range(10 if distance == "euclidean" else 3):
+        i, j = rng.integers(rows.size, size=2)
+        pursuer = Pose(*grid.cell_to_world(rows[i], cols[i]), rng.uniform(-math.pi, math.pi))
+        seen_rows, seen_cols = np.nonzero(visibility_region(grid, pursuer, camera) & smart.planner.traversable)
+        if k % 2 and seen_rows.size:  # the evader in view: the search has to go far
+            i = rng.integers(seen_rows.size)
+            me = Pose(*grid.cell_to_world(seen_rows[i], seen_cols[i]), 0.0)
+        else:
+            me = Pose(*grid.cell_to_world(rows[j], cols[j]), 0.0)
+        recorded.append(assert_same_escape(smart, me, pursuer).sample.size)
+    assert max(recorded) > MAX_RECORDED_CANDIDATES / 2  # thousands of candidates, subsampled
+
+
+@pytest.mark.parametrize("resolution", [0.05, 0.1])
+@pytest.mark.parametrize("margin", [0.0, 0.05, 0.123, 0.3, 0.31])
+def test_grown_view_matches_the_distance_transform(resolution, margin):
+    rng = np.random.default_rng(32)
+    for _ in range(10):
+        visible = np.zeros((40, 50), dtype=bool)
+        for _ in range(rng.integers(1, 4)):
+            r, c = rng.integers(0, 40), rng.integers(0, 50)
+            visible[r : r + rng.integers(1, 15), c : c + rng.integers(1, 20)] = True
+        visible &= rng.random(visible.shape) < 0.9  # holes and ragged runs
+        expected = distance_transform_edt(~visible) * resolution <= margin
+        rows, cols = np.nonzero(visible)
+        window, top, left = _grow(visible, rows.min(), rows.max() + 1, cols.min(), cols.max() + 1,
+                                  disc_half_widths(margin, resolution))
+        grown = np.zeros_like(visible)
+        grown[top : top + window.shape[0], left : left + window.shape[1]] = window
+        np.testing.assert_array_equal(grown, expected)
+
+
+def test_sample_positions_skip_the_hidden_entries():
+    rng = np.random.default_rng(33)
+    for _ in range(200):
+        size = int(rng.integers(1, 300))
+        skipped = np.flatnonzero(rng.random(size) < rng.random())
+        kept = np.setdiff1d(np.arange(size), skipped)
+        step = int(rng.integers(1, 20))
+        np.testing.assert_array_equal(_sample_positions(skipped, kept.size, step), kept[::step])
+
+
+def test_evader_in_another_room_gets_that_room_s_candidates():
+    # A full-height wall at cols 30..31 splits the grid into two rooms.
+    grid = walled_grid(40, 60, [(0, 40, 30, 32)])
+    smart = make_evader(grid)
+    pursuer = Pose(1.05, 2.05, 0.0)
+    for me in (Pose(1.55, 1.05, 0.0), Pose(4.55, 3.05, 0.0), Pose(1.55, 3.05, 0.0)):
+        found = assert_same_escape(smart, me, pursuer)
+        room = Planner(grid, EVADER.radius).reachable((me.x, me.y))
+        assert room.ravel()[found.cell] and room.ravel()[found.sample].all()
 
 
 def test_hidden_spot_behind_a_wall_beats_open_space():

@@ -30,10 +30,22 @@ The estimate is the weighted mean of the particle positions (the paper), with th
 weighted covariance (m^2).
 
 The resampling schemes are filterpy.monte_carlo's systematic, stratified, residual and
-multinomial resampling, written here as vectorised numpy on the plugin's own Generator:
-filterpy's draw from numpy's global RNG (not reproducible per component), loop in Python
-(about 1 ms for 2000 particles) and its residual_resample computes the residual from
-w instead of N w (filterpy issue #290). The tests compare these against filterpy's.
+multinomial resampling, written here on the plugin's own Generator: filterpy's draw from
+numpy's global RNG (not reproducible per component), loop in Python (about 1 ms for 2000
+particles) and its residual_resample computes the residual from w instead of N w (filterpy
+issue #290). The tests compare these against filterpy's.
+
+Fast path. :meth:`ParticleFilter.update` runs the per-particle arithmetic (unicycle
+motion, cell lookup, blocked and visible tests, weighting) and the covariance in numba
+kernels, and inverts the cumulative weights for resampling in numba. The motion draws
+happen inside the kernel, on the component's Generator through numba's ports of numpy's
+samplers: the same numbers in the same order as the plain numpy reference
+:meth:`ParticleFilter.update_reference`, which the fast path matches bit for bit in
+particles, weights, N_eff and mean (the covariance to round-off); the tests hold it to
+that. Three steps stay numpy calls on purpose, because the numba equivalents round
+differently: ``np.exp`` (numpy's SIMD exp differs from libm's in the last bit), and the
+sums and dot products behind the normalisation, N_eff and the mean (numpy's pairwise
+sums and BLAS).
 """
 
 from __future__ import annotations
@@ -44,6 +56,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+from numba import njit
 from scipy.ndimage import distance_transform_edt
 
 from pegame.api import Belief, Detection, Estimator, Pose
@@ -57,6 +70,11 @@ LOST_GATE = 5.0
 #: redraws of initial particles that land in blocked cells before snapping them to free ones
 RESEED_TRIES = 5
 
+# Where a moved particle lies, per particle, as the kernels classify it.
+_BLOCKED = 0  # in a blocked cell or off the grid
+_UNSEEN = 1  # in a free cell outside the visibility region
+_SEEN = 2  # in a free cell inside the visibility region
+
 
 def wrap(angles: np.ndarray) -> np.ndarray:
     """Wrap angles (rad) to (-pi, pi]."""
@@ -68,14 +86,18 @@ def effective_sample_size(weights: np.ndarray) -> float:
     return 1.0 / float(np.dot(weights, weights))
 
 
-def resample(weights: np.ndarray, scheme: str, rng: np.random.Generator) -> np.ndarray:
+def resample(
+    weights: np.ndarray, scheme: str, rng: np.random.Generator, reference: bool = False
+) -> np.ndarray:
     """Indices (N,) of the particles drawn with ``scheme`` (one of RESAMPLERS) from the
     non-negative ``weights`` (N,), which need not sum to 1 but must have a positive sum.
 
     Same draws as filterpy.monte_carlo's functions fed the same uniform numbers (residual:
     with the residual N w - floor(N w), the published algorithm). Only particles of
-    positive weight are ever drawn.
+    positive weight are ever drawn. ``reference`` inverts the cumulative weights with
+    plain numpy instead of the kernel (same indices).
     """
+    invert = _invert_reference if reference else _invert
     n = weights.size
     w = weights / weights.sum()
     if scheme == "residual":
@@ -84,7 +106,7 @@ def resample(weights: np.ndarray, scheme: str, rng: np.random.Generator) -> np.n
         rest = n - kept.size
         if rest == 0:
             return kept
-        return np.concatenate([kept, _invert(n * w - copies, rng.random(rest))])
+        return np.concatenate([kept, invert(n * w - copies, rng.random(rest))])
     if scheme == "systematic":
         positions = (rng.random() + np.arange(n)) / n
     elif scheme == "stratified":
@@ -93,18 +115,182 @@ def resample(weights: np.ndarray, scheme: str, rng: np.random.Generator) -> np.n
         positions = rng.random(n)
     else:
         raise ValueError(f"Unknown resampler {scheme!r}; use one of {', '.join(RESAMPLERS)}.")
-    return _invert(w, positions)
+    return invert(w, positions)
 
 
-def _invert(weights: np.ndarray, positions: np.ndarray) -> np.ndarray:
-    """For each position in [0, 1), the index whose cumulative-weight interval holds it."""
+@njit(cache=True)
+def _invert(weights, positions):
+    """For each position in [0, 1), the index whose cumulative-weight interval holds it.
+
+    Numba version of :func:`_invert_reference`, same indices: the cumulative sum is
+    accumulated in the same order, and each search returns the first index whose
+    normalised cumulative weight exceeds the position, as searchsorted(side="right") does.
+    """
+    n = weights.size
+    cumulative = np.empty(n)
+    running = 0.0
+    for i in range(n):
+        running += weights[i]
+        cumulative[i] = running
+    cumulative /= cumulative[-1]
+    last = n - 1
+    while weights[last] == 0.0:
+        last -= 1
+    indices = np.empty(positions.size, dtype=np.int64)
+    found = 0
+    for k in range(positions.size):
+        # Systematic and stratified positions increase, so each search starts where the
+        # previous one ended and the whole pass is linear; multinomial ones restart at 0.
+        if k > 0 and positions[k] < positions[k - 1]:
+            found = 0
+        found = _upper_bound(cumulative, positions[k], found)
+        # Round-off can leave the cumulative sum just below 1, or make the last systematic
+        # position exactly 1, and the search then returns N: such positions belong to the
+        # last particle of positive weight (never to a trailing zero-weight one).
+        indices[k] = min(found, last)
+    return indices
+
+
+@njit(cache=True)
+def _upper_bound(values, value, start):
+    """First index i >= start of the non-decreasing ``values`` with values[i] > value
+    (values.size when none), given values[start - 1] <= value: a galloping search, so
+    cheap when the answer is near ``start``."""
+    low, step = start, 1
+    high = start
+    while high < values.size and values[high] <= value:
+        low = high + 1
+        high = low + step
+        step *= 2
+    high = min(high, values.size)
+    while low < high:
+        middle = (low + high) // 2
+        if values[middle] <= value:
+            low = middle + 1
+        else:
+            high = middle
+    return low
+
+
+def _invert_reference(weights: np.ndarray, positions: np.ndarray) -> np.ndarray:
+    """Plain numpy :func:`_invert`."""
     cumulative = np.cumsum(weights)
     cumulative /= cumulative[-1]
     indices = np.searchsorted(cumulative, positions, side="right")
-    # Round-off can leave the cumulative sum just below 1, or make the last systematic
-    # position exactly 1, and searchsorted then returns N: such positions belong to the
-    # last particle of positive weight (never to a trailing zero-weight one).
     return np.minimum(indices, np.flatnonzero(weights)[-1])
+
+
+# --------------------------------------------------------------------------- kernels
+
+
+@njit(cache=True)
+def _wrap_angle(angle):
+    """:func:`wrap` of one angle (rad), bit for bit, mostly without fmod (slow in libm).
+
+    numpy's remainder r = (pi - angle) mod 2 pi is fmod(y, 2 pi) for y = pi - angle, plus
+    2 pi when that is negative (+0 when it is zero). For -2 pi < y < 4 pi the fmod is y
+    or y - 2 pi, exact by Sterbenz's lemma, and the addition is the same float operation
+    numpy does; other angles take the general remainder.
+    """
+    y = math.pi - angle
+    period = 2.0 * math.pi
+    if 0.0 < y < period:
+        remainder = y
+    elif period <= y < 2.0 * period:
+        remainder = y - period
+    elif -period < y < 0.0:
+        remainder = y + period
+    else:
+        remainder = y % period
+    return math.pi - remainder
+
+
+@njit(cache=True)
+def _move_and_place(particles, rng, v_max, turn_rate_std, dt, frame, blocked, visible):
+    """The particles (N, 3) moved by the unicycle model, and where each lands (N,)
+    (_BLOCKED, _UNSEEN or _SEEN).
+
+    Same draws from ``rng`` as :meth:`ParticleFilter._draw` (numba's Generator runs
+    numpy's algorithms on the same bit generator), and :meth:`ParticleFilter._predict`
+    and ``OccupancyGrid.world_to_cell`` operation for operation, so the positions and
+    cells match the reference bit for bit.
+
+    frame: the grid's (origin x m, origin y m, whether the origin yaw is nonzero,
+    cos yaw, sin yaw, resolution m).
+    """
+    n = particles.shape[0]
+    speed = rng.uniform(0.0, v_max, n)
+    normal = rng.standard_normal(n)
+    moved = np.empty((n, 3))
+    place = np.empty(n, dtype=np.int8)
+    ox, oy, rotate, c, s, res = frame
+    height, width = blocked.shape
+    for i in range(n):
+        turn = turn_rate_std * normal[i]
+        heading = particles[i, 2] + 0.5 * turn * dt
+        step = speed[i] * dt
+        x = particles[i, 0] + step * math.cos(heading)
+        y = particles[i, 1] + step * math.sin(heading)
+        moved[i, 0], moved[i, 1] = x, y
+        moved[i, 2] = _wrap_angle(particles[i, 2] + turn * dt)
+        dx, dy = x - ox, y - oy
+        if rotate:
+            dx, dy = c * dx + s * dy, -s * dx + c * dy
+        # floor stays a float until the range check: no integer overflow off the grid.
+        row, col = np.floor(dy / res), np.floor(dx / res)
+        if not (0.0 <= row < height and 0.0 <= col < width) or blocked[int(row), int(col)]:
+            place[i] = _BLOCKED
+        else:
+            place[i] = _SEEN if visible[int(row), int(col)] else _UNSEEN
+    return moved, place
+
+
+@njit(cache=True)
+def _exponents(moved, zx, zy, two_sigma2):
+    """-|p_i - z|^2 / (2 sigma^2) per particle (N,): the log-likelihood of a detection."""
+    out = np.empty(moved.shape[0])
+    for i in range(moved.shape[0]):
+        dx, dy = moved[i, 0] - zx, moved[i, 1] - zy
+        out[i] = -(dx * dx + dy * dy) / two_sigma2
+    return out
+
+
+@njit(cache=True)
+def _weigh_miss(prior, place, miss_factor):
+    """Weights (N,) after a miss: prior * miss_factor inside V, prior outside, 0 blocked."""
+    weights = np.empty(prior.size)
+    for i in range(prior.size):
+        if place[i] == _BLOCKED:
+            weights[i] = 0.0
+        else:
+            weights[i] = prior[i] * (miss_factor if place[i] == _SEEN else 1.0)
+    return weights
+
+
+@njit(cache=True)
+def _weigh_hit(prior, place, likelihood, seen_boost):
+    """Weights (N,) after a detection: prior * (likelihood * seen_boost inside V, the
+    likelihood outside), 0 on blocked cells, where ``likelihood`` is also set to 0."""
+    weights = np.empty(prior.size)
+    for i in range(prior.size):
+        if place[i] == _BLOCKED:
+            likelihood[i] = 0.0
+            weights[i] = 0.0
+        else:
+            weights[i] = prior[i] * (likelihood[i] * (seen_boost if place[i] == _SEEN else 1.0))
+    return weights
+
+
+@njit(cache=True)
+def _covariance(particles, weights, mean_x, mean_y):
+    """Weighted covariance (2, 2) (m^2) of the particle positions about the mean (m)."""
+    sxx = sxy = syy = 0.0
+    for i in range(weights.size):
+        dx, dy = particles[i, 0] - mean_x, particles[i, 1] - mean_y
+        sxx += dx * weights[i] * dx
+        sxy += dx * weights[i] * dy
+        syy += dy * weights[i] * dy
+    return np.array([[sxx, sxy], [sxy, syy]])
 
 
 class ParticleFilter(Estimator):
@@ -146,6 +332,8 @@ class ParticleFilter(Estimator):
         self._free_cells = np.flatnonzero(~self._blocked)
         if self._free_cells.size == 0:
             raise MapError(f"Map '{grid.name}' has no free cell for the particle filter to use.")
+        ox, oy, yaw = grid.origin
+        self._frame = (ox, oy, yaw != 0.0, math.cos(yaw), math.sin(yaw), float(grid.resolution))
         n = config.n_particles
         self.particles = np.zeros((n, 3))
         self.weights = np.full(n, 1.0 / n)
@@ -179,20 +367,25 @@ class ParticleFilter(Estimator):
         The belief's ``n_eff`` is N_eff of the normalised weights before any resampling
         (the value compared with rho * N), or 0 when the particle set was lost and redrawn.
         """
+        return self._update(dt, detection, visible, reference=False)
+
+    def update_reference(
+        self, dt: float, pursuer: Pose, detection: Detection | None, visible: np.ndarray
+    ) -> Belief:
+        """:meth:`update` in plain numpy: the reference the tests hold the kernels to."""
+        return self._update(dt, detection, visible, reference=True)
+
+    def _update(
+        self, dt: float, detection: Detection | None, visible: np.ndarray, reference: bool
+    ) -> Belief:
+        """:meth:`update`, or with ``reference`` :meth:`update_reference`."""
         cfg = self.config
-        moved = self._predict(dt)
-        flat, on_grid = self._cells(moved[:, 0], moved[:, 1])
-        valid = on_grid & ~self._blocked[flat]
-        seen = on_grid & self._flat_mask(visible)[flat]
-        prior = self.weights
-        if detection is None:
-            lost = False
-            factor = np.where(seen, cfg.miss_factor, 1.0)
-        else:
-            likelihood = self._likelihood(moved, detection.position) * valid
-            lost = float(np.dot(prior, likelihood)) < math.exp(-0.5 * LOST_GATE**2)
-            factor = likelihood * np.where(seen, cfg.seen_boost, 1.0)
-        weights = prior * factor * valid
+        self._flat_mask(visible)  # rejects a mask of the wrong shape before any draw
+        weigh = self._weigh_reference if reference else self._weigh
+        moved, weights, likelihood = weigh(dt, detection, visible)
+        lost = detection is not None and (
+            float(np.dot(self.weights, likelihood)) < math.exp(-0.5 * LOST_GATE**2)
+        )
         total = float(weights.sum())
         if lost or not (total > 0.0 and math.isfinite(total)):
             return self._reinitialise(detection, visible)
@@ -200,18 +393,56 @@ class ParticleFilter(Estimator):
         n_eff = effective_sample_size(weights)
         resampled = n_eff < cfg.rho * cfg.n_particles
         if resampled:
-            moved = moved[resample(weights, cfg.resampler, self.rng)]
+            # take() copies rows three times faster than fancy indexing.
+            moved = np.take(moved, resample(weights, cfg.resampler, self.rng, reference), axis=0)
             weights = np.full(cfg.n_particles, 1.0 / cfg.n_particles)
         self.particles, self.weights = moved, weights
-        return self._belief(n_eff, resampled)
+        return self._belief(n_eff, resampled, reference)
 
     # ------------------------------------------------------------------ models
 
-    def _predict(self, dt: float) -> np.ndarray:
-        """The particles (N, 3) moved by the unicycle model over dt seconds."""
-        n, p = self.config.n_particles, self.particles
+    def _weigh(self, dt, detection, visible):
+        """Draw the motion and return the moved particles (N, 3), their unnormalised
+        weights (N,) and, with a detection, its likelihood (N,) (0 on blocked cells;
+        else None), by the kernels."""
+        cfg = self.config
+        moved, place = _move_and_place(
+            self.particles, self.rng, self.context.evader.v_max, cfg.turn_rate_std, dt,
+            self._frame, self.context.grid.blocked, visible,
+        )
+        if detection is None:
+            return moved, _weigh_miss(self.weights, place, cfg.miss_factor), None
+        zx, zy = detection.position
+        likelihood = np.exp(_exponents(moved, zx, zy, 2.0 * cfg.sigma**2))
+        weights = _weigh_hit(self.weights, place, likelihood, cfg.seen_boost)
+        return moved, weights, likelihood
+
+    def _weigh_reference(self, dt, detection, visible):
+        """Plain numpy :meth:`_weigh`."""
+        cfg = self.config
+        moved = self._predict(dt, *self._draw())
+        flat, on_grid = self._cells(moved[:, 0], moved[:, 1])
+        valid = on_grid & ~self._blocked[flat]
+        seen = on_grid & self._flat_mask(visible)[flat]
+        if detection is None:
+            likelihood = None
+            factor = np.where(seen, cfg.miss_factor, 1.0)
+        else:
+            likelihood = self._likelihood(moved, detection.position) * valid
+            factor = likelihood * np.where(seen, cfg.seen_boost, 1.0)
+        return moved, self.weights * factor * valid, likelihood
+
+    def _draw(self) -> tuple[np.ndarray, np.ndarray]:
+        """The motion model's draws: speeds (N,) ~ U[0, v_max] (m/s) and turn rates (N,)
+        ~ N(0, turn_rate_std^2) (rad/s)."""
+        n = self.config.n_particles
         speed = self.rng.uniform(0.0, self.context.evader.v_max, n)
-        turn = self.config.turn_rate_std * self.rng.standard_normal(n)
+        return speed, self.config.turn_rate_std * self.rng.standard_normal(n)
+
+    def _predict(self, dt: float, speed: np.ndarray, turn: np.ndarray) -> np.ndarray:
+        """The particles (N, 3) moved over dt seconds by the unicycle model with speeds
+        (N,) (m/s) and turn rates (N,) (rad/s)."""
+        p = self.particles
         heading = p[:, 2] + 0.5 * turn * dt
         return np.column_stack(
             (
@@ -325,7 +556,7 @@ class ParticleFilter(Estimator):
 
     # ------------------------------------------------------------------ output
 
-    def _belief(self, n_eff: float, resampled: bool) -> Belief:
+    def _belief(self, n_eff: float, resampled: bool, reference: bool = False) -> Belief:
         """The belief: weighted mean (m) and covariance (m^2) of the particle positions.
 
         The particle and weight arrays are shared with the belief, so they are made
@@ -334,9 +565,14 @@ class ParticleFilter(Estimator):
         self.particles.setflags(write=False)
         self.weights.setflags(write=False)
         xy, w = self.particles[:, :2], self.weights
+        # numpy's product, also on the fast path: the mean steers the pursuer, and BLAS
+        # sums in its own order, so a numba sum would not give the same games.
         mean = w @ xy
-        offset = xy - mean
-        covariance = (offset * w[:, None]).T @ offset
+        if reference:
+            offset = xy - mean
+            covariance = (offset * w[:, None]).T @ offset
+        else:
+            covariance = _covariance(self.particles, w, mean[0], mean[1])
         return Belief(
             mean=(float(mean[0]), float(mean[1])),
             covariance=covariance,
