@@ -139,6 +139,15 @@ class SensorFrame:
     when the simulator renders images. evader_truth: the simulator's ground-truth evader
     pose, for simulator-side detectors (oracle, segmentation) only; strategies and
     estimators never receive a SensorFrame.
+
+    With rendered images, a camera's calibration as a depth camera driver gives it:
+    intrinsics, the (3, 3) pinhole matrix K of rgb and depth in their own pixels (pixel
+    (row i, col j) spans [j, j+1] x [i, i+1], so its centre is at (j + 0.5, i + 0.5));
+    depth is the distance along the optical axis (m), inf where nothing is within range;
+    camera_to_map, the (4, 4) homogeneous transform from the optical frame (x right, y
+    down, z forward; m) to the map frame with z up and the floor at z = 0 (it holds the
+    camera's height and tilt); labels, segmentation values by name (e.g. ``"evader"``),
+    for simulator-side detectors only.
     """
 
     time: float
@@ -147,6 +156,9 @@ class SensorFrame:
     rgb: np.ndarray | None = None
     depth: np.ndarray | None = None
     segmentation: np.ndarray | None = None
+    intrinsics: np.ndarray | None = None
+    camera_to_map: np.ndarray | None = None
+    labels: dict[str, int] | None = None
 
 
 @dataclass(frozen=True)

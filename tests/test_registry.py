@@ -83,4 +83,5 @@ def test_plugins_listing_shows_every_plugin_with_its_distribution():
     for group, ep_group in registry.GROUPS.items():
         assert f"{group} ({ep_group})" in out
         for name in registry.available(group):
-            assert any(line.split()[:2] == [name, "pegame"] for line in out.splitlines()), name
+            dist = registry.distribution_of(registry.entry_point(group, name))
+            assert any(line.split()[:2] == [name, dist] for line in out.splitlines()), name

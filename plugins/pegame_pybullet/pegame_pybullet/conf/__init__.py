@@ -1,0 +1,1 @@
+"""Config files of pegame-pybullet, found by pegame through the pegame.configs entry point."""

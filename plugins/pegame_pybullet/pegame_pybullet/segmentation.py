@@ -1,0 +1,88 @@
+"""``detector=segmentation``: the reference detector, reading the renderer's segmentation.
+
+The evader's pixels are exactly those labelled ``evader`` in ``frame.segmentation``,
+kept when their back-projected point lies within the camera's sensing range [near, far]
+(m, horizontal distance from the camera, as :func:`pegame.geometry.in_view` measures it).
+With fewer than ``min_pixels`` of them there is no detection. Otherwise (paper, Sec.
+"Object tracking from static camera"):
+
+- box: the pixels' bounding box, scaled from the rendered resolution to the pursuer's
+  ``camera.image_width`` x ``camera.image_height`` pixel frame that strategies use;
+- depth: the median of the pixels' depth (m, along the optical axis);
+- position: every pixel is back-projected through the intrinsics and the camera pose
+  (``frame.intrinsics``, ``frame.camera_to_map``); the median of their map (x, y) lies on
+  the evader's visible surface, so it is moved ``surface_offset`` m further along the
+  horizontal ray from the camera, to the evader's axis.
+
+Needs a simulator that renders segmentation (``sim=pybullet``); imports no pybullet.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pegame.api import BoundingBox, Detection, Detector, SensorFrame
+from pegame.errors import ConfigError, require
+
+
+def backproject(frame: SensorFrame, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """(3, N) map-frame points (m) of the pixels (rows, cols) at their depth."""
+    k = frame.intrinsics
+    z = frame.depth[rows, cols]
+    optical = np.stack([(cols + 0.5 - k[0, 2]) * (z / k[0, 0]), (rows + 0.5 - k[1, 2]) * (z / k[1, 1]), z])
+    return frame.camera_to_map[:3, :3] @ optical + frame.camera_to_map[:3, 3:]
+
+
+def box_in_camera_frame(frame: SensorFrame, camera, left, top, right, bottom) -> BoundingBox:
+    """A box given by pixel edges (px of the rendered image) in the pursuer camera's
+    ``image_width`` x ``image_height`` frame."""
+    height, width = frame.depth.shape
+    sx, sy = camera.image_width / width, camera.image_height / height
+    return BoundingBox(
+        float(left * sx), float(top * sy), float((right - left) * sx), float((bottom - top) * sy)
+    )
+
+
+class SegmentationDetector(Detector):
+    """The evader's exact pixels from the segmentation mask."""
+
+    description = "Reference detector: the evader's pixels in the rendered segmentation (sim=pybullet)."
+
+    @dataclass
+    class Config:
+        min_pixels: int = 5  # fewer evader pixels than this: not detected
+        surface_offset: float = 0.12  # m from the evader's visible surface to its axis
+
+        def __post_init__(self) -> None:
+            require(self.min_pixels >= 1, "detector.min_pixels", "a whole number >= 1", self.min_pixels)
+            require(
+                self.surface_offset >= 0, "detector.surface_offset", "a distance >= 0 m", self.surface_offset
+            )
+
+    def detect(self, frame: SensorFrame) -> Detection | None:
+        if frame.segmentation is None or frame.labels is None or "evader" not in frame.labels:
+            raise ConfigError(
+                "detector=segmentation needs a simulator that renders a segmentation mask with an "
+                "'evader' label (sim=pybullet); use detector=oracle with sim=grid."
+            )
+        camera = self.context.camera
+        rows, cols = np.nonzero(frame.segmentation == frame.labels["evader"])
+        if rows.size < self.config.min_pixels:
+            return None
+        x, y, _ = backproject(frame, rows, cols)
+        origin = frame.camera_to_map[:2, 3]
+        ranges = np.hypot(x - origin[0], y - origin[1])
+        keep = (ranges >= camera.near) & (ranges <= camera.far)
+        kept = int(np.count_nonzero(keep))
+        if kept < self.config.min_pixels:
+            return None
+        if kept < rows.size:
+            rows, cols, x, y = rows[keep], cols[keep], x[keep], y[keep]
+        box = box_in_camera_frame(frame, camera, cols.min(), rows.min(), cols.max() + 1, rows.max() + 1)
+        surface = np.array([np.median(x), np.median(y)])
+        ray = surface - origin
+        position = surface + self.config.surface_offset * ray / max(float(np.hypot(*ray)), 1e-9)
+        depth = float(np.median(frame.depth[rows, cols]))
+        return Detection(box=box, depth=depth, position=(float(position[0]), float(position[1])))

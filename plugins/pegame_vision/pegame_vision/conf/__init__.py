@@ -1,0 +1,1 @@
+"""Config files of pegame-vision, found by pegame through the pegame.configs entry point."""

@@ -1,0 +1,162 @@
+"""``detector=vision``: detect the evader by colour, track it with Lucas-Kanade, place it
+with the depth image (paper, Sec. "Object tracking from static camera").
+
+Reads only what an RGB-D camera driver gives: ``frame.rgb``, ``frame.depth`` and the
+calibration (``frame.intrinsics``, ``frame.camera_to_map``); never the simulator's
+segmentation, labels or ``evader_truth``. Each frame either
+
+- detects: the pixels that match the colour model (:class:`pegame_vision.colour.
+  ColourModel`), in components of at least ``min_component`` px, at least ``min_pixels``
+  of them; their bounding box is the evader's, and Lucas-Kanade features are taken on
+  them; this happens every ``redetect_every``-th frame, and at once when tracking fails;
+- or tracks: the features follow the evader (:class:`pegame_vision.tracker.BoxTracker`),
+  and the frame counts as tracked while at least ``min_features`` of them survive the
+  forward-backward check and still show the evader's colours (the quality bar).
+
+The evader's samples (the matching pixels, or the surviving features) are back-projected
+with their depth; those with no depth or outside the camera's range [near, far] (m,
+horizontal) are dropped. The depth is the samples' median depth (m along the optical
+axis), the position their median map (x, y) moved ``surface_offset`` m further from the
+camera, from the body's visible surface to its axis. Boxes are reported in the pursuer
+camera's ``image_width`` x ``image_height`` frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pegame.api import BoundingBox, Detection, Detector, SensorFrame
+from pegame.errors import ConfigError, require
+from pegame_vision.colour import ColourModel, find_blobs, parse_hex
+from pegame_vision.opencv import cv2
+from pegame_vision.tracker import BoxTracker
+
+#: the clothing and skin of sim=pybullet's evader: shirt, trousers, skin
+EVADER_COLOURS = ["#cc1f1a", "#1f38a6", "#dead8c"]
+MIN_SAMPLES = 3  # back-projected samples needed to place the evader
+
+
+class VisionDetector(Detector):
+    """Colour-model detection and Lucas-Kanade tracking on RGB-D frames."""
+
+    description = "OpenCV on RGB-D: colour model of the evader's clothing, Lucas-Kanade tracking."
+
+    @dataclass
+    class Config:
+        colours: list[str] = field(default_factory=lambda: list(EVADER_COLOURS))  # '#rrggbb', the evader's
+        hue_tolerance: float = 12.0  # degrees of hue around each colour
+        min_saturation: float = 0.25  # HSV saturation in [0, 1] below which a pixel has no reliable hue
+        min_value: float = 0.08  # HSV value in [0, 1] below which a pixel is too dark to judge
+        min_pixels: int = 12  # matching pixels needed for a detection
+        min_component: int = 3  # px; smaller matching specks are noise
+        redetect_every: int = 5  # detect on every K-th frame while tracking (1: every frame)
+        min_features: int = 4  # fewer tracked features than this: re-detect at once
+        max_features: int = 40  # features tracked at most
+        surface_offset: float = 0.12  # m from the evader's visible surface to its axis
+
+        def __post_init__(self) -> None:
+            require(len(self.colours) > 0, "detector.colours", "a non-empty list of '#rrggbb'", self.colours)
+            for colour in self.colours:
+                try:
+                    parse_hex(colour)
+                except ValueError:
+                    require(False, "detector.colours", "colours written '#rrggbb'", colour)
+            require(
+                0 < self.hue_tolerance <= 90, "detector.hue_tolerance", "(0, 90] degrees", self.hue_tolerance
+            )
+            for key in ("min_saturation", "min_value"):
+                require(0 <= getattr(self, key) <= 1, f"detector.{key}", "[0, 1]", getattr(self, key))
+            for key in ("min_pixels", "min_component", "redetect_every", "min_features", "max_features"):
+                require(getattr(self, key) >= 1, f"detector.{key}", "a whole number >= 1", getattr(self, key))
+            require(
+                self.surface_offset >= 0, "detector.surface_offset", "a distance >= 0 m", self.surface_offset
+            )
+
+    def __init__(self, config, context, rng) -> None:
+        super().__init__(config, context, rng)
+        self.model = ColourModel(
+            config.colours, config.hue_tolerance, config.min_saturation, config.min_value
+        )
+        self.tracker = BoxTracker(config.max_features)
+        self.reset()
+
+    def reset(self) -> None:
+        self._tracking = False
+        self._since_detection = 0
+        self._frame: SensorFrame | None = None
+        self._last: Detection | None = None
+        self.source: str | None = None  # how the last detection was made: "detect" or "track"
+
+    def detect(self, frame: SensorFrame) -> Detection | None:
+        if frame is self._frame:  # the simulator reused its last frame: nothing new to see
+            return self._last
+        needed = (frame.rgb, frame.depth, frame.intrinsics, frame.camera_to_map)
+        if any(value is None for value in needed):
+            raise ConfigError(
+                "detector=vision needs RGB-D frames with the camera calibration (sim=pybullet); "
+                "use detector=oracle with sim=grid."
+            )
+        self._frame = frame
+        gray = cv2.cvtColor(frame.rgb, cv2.COLOR_RGB2GRAY)
+        samples, source = (self._track(frame, gray) if self._tracking else None), "track"
+        if samples is None:
+            samples, source = self._detect(frame, gray), "detect"
+        self._last = None if samples is None else self._place(frame, *samples)
+        self.source = None if self._last is None else source
+        return self._last
+
+    def _track(self, frame: SensorFrame, gray: np.ndarray):
+        """(box, rows, cols) from Lucas-Kanade, or None when it is time or necessary to
+        detect again."""
+        if self._since_detection >= self.config.redetect_every:
+            return None
+        survivors = self.tracker.step(gray, lambda points: self.model.matches_at(frame.rgb, points))
+        if survivors < self.config.min_features:
+            self._tracking = False
+            return None
+        self._since_detection += 1
+        height, width = gray.shape
+        left, top, right, bottom = self.tracker.box
+        box = (max(0.0, left), max(0.0, top), min(float(width), right), min(float(height), bottom))
+        points = self.tracker.points
+        return box, points[:, 1].astype(int), points[:, 0].astype(int)
+
+    def _detect(self, frame: SensorFrame, gray: np.ndarray):
+        """(box, rows, cols) of the pixels matching the colour model, or None."""
+        mask = find_blobs(self.model.mask(frame.rgb), self.config.min_component)
+        rows, cols = np.nonzero(mask)
+        self._tracking = False
+        if rows.size < self.config.min_pixels:
+            return None
+        box = (float(cols.min()), float(rows.min()), float(cols.max() + 1), float(rows.max() + 1))
+        self._tracking = self.tracker.start(gray, np.array(box), mask) >= self.config.min_features
+        self._since_detection = 1  # frames since (and including) this detection
+        return box, rows, cols
+
+    def _place(self, frame: SensorFrame, box, rows: np.ndarray, cols: np.ndarray) -> Detection | None:
+        """The detection from the box (px) and the evader's sample pixels, or None when too
+        few samples have a depth within range."""
+        k, transform = frame.intrinsics, frame.camera_to_map
+        z = frame.depth[rows, cols].astype(float)
+        optical = np.stack([(cols + 0.5 - k[0, 2]) * z / k[0, 0], (rows + 0.5 - k[1, 2]) * z / k[1, 1], z])
+        with np.errstate(invalid="ignore"):  # inf depth (no return) gives nan, dropped below
+            x, y, _ = transform[:3, :3] @ optical + transform[:3, 3:]
+        origin = transform[:2, 3]
+        ranges = np.hypot(x - origin[0], y - origin[1])
+        camera = self.context.camera
+        valid = np.isfinite(z) & (ranges >= camera.near) & (ranges <= camera.far)
+        if np.count_nonzero(valid) < MIN_SAMPLES:
+            return None
+        surface = np.array([np.median(x[valid]), np.median(y[valid])])
+        ray = surface - origin
+        position = surface + self.config.surface_offset * ray / max(float(np.hypot(*ray)), 1e-9)
+        height, width = frame.depth.shape
+        sx, sy = camera.image_width / width, camera.image_height / height
+        left, top, right, bottom = box
+        return Detection(
+            box=BoundingBox(left * sx, top * sy, (right - left) * sx, (bottom - top) * sy),
+            depth=float(np.median(z[valid])),
+            position=(float(position[0]), float(position[1])),
+        )

@@ -1,0 +1,25 @@
+"""Fixtures of the plugin tests: the small map of :mod:`plugin_worlds` and a context on it.
+
+Imports no plugin, so that a test file skips cleanly when its plugin's dependency is missing.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from pegame.api import Body, Camera, Context
+from pegame.maps import OccupancyGrid
+from plugin_worlds import small_map
+
+
+@pytest.fixture
+def grid() -> OccupancyGrid:
+    return small_map()
+
+
+@pytest.fixture
+def context(grid) -> Context:
+    """The default bodies and camera (pi/3 FOV, 0.3-5 m, 640x480) on the small map."""
+    return Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), Camera(fov=math.pi / 3), 0.1, 1.0)

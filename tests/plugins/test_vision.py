@@ -1,0 +1,102 @@
+"""detector=vision: finds and tracks the evader on rendered RGB-D frames alone."""
+
+from __future__ import annotations
+
+import pytest
+
+pytest.importorskip("cv2")
+pytest.importorskip("pybullet")  # the frames are rendered by sim=pybullet
+
+import dataclasses  # noqa: E402
+import math  # noqa: E402
+import sys  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from pegame import registry  # noqa: E402
+from pegame.api import Body, Camera, Context, Pose, SensorFrame  # noqa: E402
+from pegame.errors import ConfigError  # noqa: E402
+from pegame.maps import OccupancyGrid  # noqa: E402
+from pegame_pybullet.segmentation import SegmentationDetector  # noqa: E402
+from pegame_pybullet.sim import PybulletSimulator  # noqa: E402
+from pegame_vision.detector import VisionDetector  # noqa: E402
+from pegame_vision.evaluate import iou  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def walk():
+    """Frames of an evader walking across the view of a pursuer that turns slowly, in an
+    empty 8 m x 4 m room, with the reference detections: [(frame, reference)]."""
+    grid = OccupancyGrid(np.zeros((80, 160), dtype=np.int8), 0.05, name="room")
+    context = Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
+    sim = PybulletSimulator(PybulletSimulator.Config(), context, np.random.default_rng(0))
+    reference = SegmentationDetector(SegmentationDetector.Config(), context, np.random.default_rng(0))
+    frames = []
+    try:
+        for k in range(70):
+            sim.reset(Pose(0.5, 2.0, 0.004 * k), Pose(3.0, 0.3 + 0.05 * k, math.pi / 2))
+            frame = sim.sense(0.1 * k)
+            frames.append((frame, reference.detect(frame)))
+    finally:
+        sim.close()
+    return context, frames
+
+
+def run(context, frames, **options):
+    detector = VisionDetector(VisionDetector.Config(**options), context, np.random.default_rng(0))
+    detector.reset()
+    out = []
+    for frame, _ in frames:
+        out.append((detector.detect(frame), detector.source))
+    return out
+
+
+def test_finds_and_tracks_the_evader_across_the_view(walk):
+    context, frames = walk
+    found = run(context, frames)
+    seen = [(truth, mine, frame.evader_truth) for (frame, truth), (mine, _) in zip(frames, found) if truth]
+    assert 40 < len(seen) < len(frames)  # the walk starts and ends out of view
+    matched = [(mine, evader) for truth, mine, evader in seen if mine and iou(truth.box, mine.box) >= 0.5]
+    assert len(matched) >= 0.9 * len(seen)
+    errors = [math.hypot(mine.position[0] - e.x, mine.position[1] - e.y) for mine, e in matched]
+    assert np.median(errors) < 0.15
+    sources = [source for _, source in found]
+    assert sources.count("track") >= 0.5 * len(seen)  # Lucas-Kanade carries most frames
+    assert "detect" in sources
+    for (frame, truth), (mine, _) in zip(frames, found):
+        if truth is None:
+            assert mine is None
+
+
+def test_reads_only_the_rgb_d_image_and_calibration(walk):
+    context, frames = walk
+    blind = [(dataclasses.replace(frame, segmentation=None, labels=None, evader_truth=None), truth)
+             for frame, truth in frames]
+    assert [d for d, _ in run(context, blind)] == [d for d, _ in run(context, frames)]
+
+
+def test_redetects_every_k_frames(walk):
+    context, frames = walk
+    sources = [source for _, source in run(context, frames, redetect_every=1)]
+    assert "track" not in sources and "detect" in sources
+
+
+def test_frames_without_images_are_a_clear_error(context):
+    detector = VisionDetector(VisionDetector.Config(), context, np.random.default_rng(0))
+    with pytest.raises(ConfigError, match="sim=pybullet"):
+        detector.detect(SensorFrame(time=0.0, camera_pose=Pose(0, 0)))
+
+
+def test_bad_colours_are_config_errors():
+    with pytest.raises(ConfigError, match="detector.colours"):
+        VisionDetector.Config(colours=["red"])
+
+
+def test_missing_opencv_is_an_import_error_naming_it(monkeypatch):
+    monkeypatch.setitem(sys.modules, "cv2", None)
+    for name in [m for m in sys.modules if m.startswith("pegame_vision")]:
+        monkeypatch.delitem(sys.modules, name)
+    with pytest.raises(registry.PluginError) as info:
+        registry.load("detector", "vision")
+    assert "cv2" in str(info.value) and "pip install opencv-python-headless" in str(info.value)
+    assert isinstance(info.value.__cause__, ImportError)
