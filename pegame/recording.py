@@ -357,6 +357,13 @@ class RerunRecorder(Recorder):
             return
         self._rec.set_time(STEP, sequence=tick.step)
         self._rec.set_time(SIM_TIME, duration=tick.time)
+        size = (self.context.camera.image_width, self.context.camera.image_height)
+        if rgb.shape[1::-1] != size:
+            # Detections are in the camera's image_width x image_height pixel frame; a
+            # simulator may render smaller, so the image is scaled to that frame.
+            from PIL import Image
+
+            rgb = np.asarray(Image.fromarray(rgb).resize(size, Image.BILINEAR))
         image = rr.Image(rgb).compress(jpeg_quality=self.config.jpeg_quality)
         self._rec.log("camera/image", image, strict=True)
 
