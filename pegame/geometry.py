@@ -20,7 +20,10 @@ go to cells exactly as :meth:`OccupancyGrid.world_to_cell` does, origin yaw incl
 
 Two implementations give identical masks: :func:`visibility_region_reference`, plain
 vectorised numpy over all rays and samples, and the numba ray march behind
-:func:`visibility_region`, which stops each ray at its first blocked sample.
+:func:`visibility_region`, which stops each ray at its first blocked sample. Likewise
+:func:`line_of_sight` is a numba kernel with the numpy reference
+``_line_of_sight_reference``. The small numba helpers :func:`grid_frame`,
+:func:`point_cell` and :func:`cell_blocked` serve other modules' kernels too.
 """
 
 from __future__ import annotations
@@ -86,28 +89,120 @@ def visibility_region_reference(grid: OccupancyGrid, pose: Pose, camera: Camera)
     return mask
 
 
+# ------------------------------------------------------------------ numba helpers
+# The kernels take the map-to-cell transform as a "frame" tuple (ox, oy, cos yaw, sin yaw,
+# yaw != 0, resolution) and reproduce OccupancyGrid.world_to_cell operation for operation,
+# so they pick exactly the cells that the numpy code picks.
+
+
+def grid_frame(grid: OccupancyGrid) -> tuple[float, float, float, float, bool, float]:
+    """The frame tuple of ``grid`` for :func:`point_cell` and the kernels."""
+    ox, oy, yaw = grid.origin
+    return ox, oy, math.cos(yaw), math.sin(yaw), yaw != 0.0, float(grid.resolution)
+
+
+@njit(cache=True, inline="always")
+def point_cell(x, y, frame):
+    """(row, col) of the cell containing map point (x, y) (m); may lie off the grid."""
+    ox, oy, c, s, rotate, res = frame
+    dx = x - ox
+    dy = y - oy
+    if rotate:
+        dx, dy = c * dx + s * dy, -s * dx + c * dy
+    return math.floor(dy / res), math.floor(dx / res)
+
+
+@njit(cache=True, inline="always")
+def cell_blocked(blocked, row, col):
+    """True when (row, col) is off the grid or True in the bool (H, W) mask ``blocked``."""
+    height, width = blocked.shape
+    return row < 0 or row >= height or col < 0 or col >= width or blocked[row, col]
+
+
+#: cells; a sample whose cell coordinate is closer than this to a cell edge is recomputed
+#: with a division (the product with 1 / resolution may round to the other side)
+_EDGE = 1e-9
+
+
+@njit(cache=True, inline="always")
+def _ray_cells(px, py, ray, distances, frame, shape, divide, cells):
+    """Flat row-major cell index (row * width + col) of every sample of one ray, -1 off the grid.
+
+    The ray starts at (px, py) (map frame, m) along ``ray`` = (cos, sin); sample j is at
+    range ``distances[j]`` m; ``shape`` is the grid's (height, width). With ``divide`` the
+    cell coordinates are the quotients by the resolution, as in :func:`point_cell`. Without
+    it they are products with 1 / resolution, a few times cheaper; a product floors to the
+    same integer as the quotient unless both lie within rounding error of an integer, so
+    the function returns False when any sample came within _EDGE cells of a cell edge (the
+    caller then redoes the ray with ``divide``) and True otherwise.
+    """
+    ox, oy, c, s, rotate, res = frame
+    cos_i, sin_i = ray
+    height, width = shape
+    inv = 1.0 / res
+    clear = True
+    for j in range(distances.size):
+        dx = px + distances[j] * cos_i - ox
+        dy = py + distances[j] * sin_i - oy
+        if rotate:
+            dx, dy = c * dx + s * dy, -s * dx + c * dy
+        if divide:
+            u = np.floor(dx / res)
+            v = np.floor(dy / res)
+        else:
+            qu = dx * inv
+            qv = dy * inv
+            u = np.floor(qu)
+            v = np.floor(qv)
+            # Bitwise & (no short circuit) keeps the loop free of branches, so it vectorises.
+            clear &= (qu - u >= _EDGE) & (u + 1.0 - qu >= _EDGE)
+            clear &= (qv - v >= _EDGE) & (v + 1.0 - qv >= _EDGE)
+        col = np.int64(u)
+        row = np.int64(v)
+        inside = (row >= 0) & (row < height) & (col >= 0) & (col < width)
+        cells[j] = row * width + col if inside else -1
+    return clear
+
+
 @njit(cache=True)
-def _march(blocked, cos_a, sin_a, distances, first, px, py, ox, oy, c, s, rotate, res, mask):
+def _march(blocked, cos_a, sin_a, distances, first, px, py, frame, mask):
     """Mark in ``mask`` the cells seen along each ray, stopping at the first blocked one.
 
-    Ray directions come precomputed by numpy, and ``OccupancyGrid.world_to_cell`` is
-    reproduced operation for operation (``c``, ``s``: cos and sin of the origin yaw,
-    applied when ``rotate``), so the result matches :func:`visibility_region_reference`
-    bit for bit.
+    Ray directions come precomputed by numpy and cells follow ``OccupancyGrid.world_to_cell``
+    exactly (:func:`_ray_cells`), so the result matches :func:`visibility_region_reference`
+    bit for bit. Each ray's cells are computed in one branch-free pass before the walk
+    along it, which is faster than stopping the computation at the first blocked sample.
     """
-    height, width = blocked.shape
+    blocked_flat, mask_flat = blocked.ravel(), mask.ravel()
+    cells = np.empty(distances.size, dtype=np.int64)
     for i in range(cos_a.size):
+        ray = (cos_a[i], sin_a[i])
+        if not _ray_cells(px, py, ray, distances, frame, blocked.shape, False, cells):
+            _ray_cells(px, py, ray, distances, frame, blocked.shape, True, cells)
         for j in range(distances.size):
-            dx = px + distances[j] * cos_a[i] - ox
-            dy = py + distances[j] * sin_a[i] - oy
-            if rotate:
-                dx, dy = c * dx + s * dy, -s * dx + c * dy
-            col = math.floor(dx / res)
-            row = math.floor(dy / res)
-            if row < 0 or row >= height or col < 0 or col >= width or blocked[row, col]:
+            cell = cells[j]
+            if cell < 0 or blocked_flat[cell]:
                 break
             if j >= first:
-                mask[row, col] = True
+                mask_flat[cell] = True
+
+
+@njit(cache=True)
+def _segment_clear(blocked, ax, ay, bx, by, step, frame):
+    """Kernel of :func:`line_of_sight`: the same samples as the numpy reference, where
+    ``np.linspace(0, 1, count + 1)`` gives t = k * (1 / count) and exactly 1 at the end."""
+    count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
+    dx, dy = bx - ax, by - ay
+    dt = 1.0 / count
+    for k in range(count + 1):
+        t = 1.0 if k == count else k * dt
+        row, col = point_cell(ax + t * dx, ay + t * dy, frame)
+        if cell_blocked(blocked, row, col):
+            return False
+    return True
+
+
+# ----------------------------------------------------------------- visibility region
 
 
 def visibility_region(grid: OccupancyGrid, pose: Pose, camera: Camera) -> np.ndarray:
@@ -121,27 +216,17 @@ def visibility_region(grid: OccupancyGrid, pose: Pose, camera: Camera) -> np.nda
     """
     _, distances, first = _ray_tables(camera)
     cos_a, sin_a = _ray_directions(pose, camera)
-    ox, oy, yaw = grid.origin
     mask = np.zeros(grid.blocked.shape, dtype=bool)
-    _march(
-        grid.blocked, cos_a, sin_a, distances, first, float(pose.x), float(pose.y),
-        ox, oy, math.cos(yaw), math.sin(yaw), yaw != 0.0, float(grid.resolution), mask,
-    )
+    px, py = float(pose.x), float(pose.y)
+    _march(grid.blocked, cos_a, sin_a, distances, first, px, py, grid_frame(grid), mask)
     return mask
 
 
-def line_of_sight(grid: OccupancyGrid, a_xy, b_xy, step: float | None = None) -> bool:
-    """True when the segment from ``a_xy`` to ``b_xy`` (map frame, m) crosses no blocked cell.
+# --------------------------------------------------------------------- line of sight
 
-    The segment is sampled at most ``step`` m apart (default: half the grid resolution),
-    both endpoints included; a sample off the grid or in a blocked (occupied or unknown)
-    cell breaks the line of sight, so an endpoint in a blocked cell gives False. Like the
-    visibility mask this is a sampled test: it may miss a cell whose corner the segment
-    only grazes over less than ``step``.
-    """
-    step = 0.5 * grid.resolution if step is None else step
-    if step <= 0.0:
-        raise ValueError(f"step must be positive, got {step}")
+
+def _line_of_sight_reference(grid: OccupancyGrid, a_xy, b_xy, step: float) -> bool:
+    """Plain numpy reference of :func:`line_of_sight` (``step`` given, > 0)."""
     a = np.asarray(a_xy, dtype=float)
     b = np.asarray(b_xy, dtype=float)
     count = max(1, math.ceil(float(np.hypot(*(b - a))) / step))
@@ -153,6 +238,23 @@ def line_of_sight(grid: OccupancyGrid, a_xy, b_xy, step: float | None = None) ->
     return not bool(np.any(grid.blocked[rows, cols]))
 
 
+def line_of_sight(grid: OccupancyGrid, a_xy, b_xy, step: float | None = None) -> bool:
+    """True when the segment from ``a_xy`` to ``b_xy`` (map frame, m) crosses no blocked cell.
+
+    The segment is sampled at most ``step`` m apart (default: half the grid resolution),
+    both endpoints included; a sample off the grid or in a blocked (occupied or unknown)
+    cell breaks the line of sight, so an endpoint in a blocked cell gives False. Like the
+    visibility mask this is a sampled test: it may miss a cell whose corner the segment
+    only grazes over less than ``step``.
+    """
+    step = 0.5 * grid.resolution if step is None else float(step)
+    if step <= 0.0:
+        raise ValueError(f"step must be positive, got {step}")
+    ax, ay = float(a_xy[0]), float(a_xy[1])
+    bx, by = float(b_xy[0]), float(b_xy[1])
+    return _segment_clear(grid.blocked, ax, ay, bx, by, step, grid_frame(grid))
+
+
 def in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, point_xy) -> bool:
     """True when the camera at ``pose`` sees the map-frame point ``point_xy`` (m).
 
@@ -161,13 +263,13 @@ def in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, point_xy) -> bool:
     :func:`line_of_sight` from the camera to the point holds. Near the wedge edges and
     range limits it may disagree with the discretised mask by about one cell.
     """
-    dx = float(point_xy[0]) - pose.x
-    dy = float(point_xy[1]) - pose.y
+    x, y = float(point_xy[0]), float(point_xy[1])
+    dx, dy = x - pose.x, y - pose.y
     if not camera.near <= math.hypot(dx, dy) <= camera.far:
         return False
     if abs(wrap_angle(math.atan2(dy, dx) - pose.theta)) > 0.5 * camera.fov:
         return False
-    return line_of_sight(grid, (pose.x, pose.y), (float(point_xy[0]), float(point_xy[1])))
+    return line_of_sight(grid, (pose.x, pose.y), (x, y))
 
 
 def fov_wedge(camera: Camera, pose: Pose, n: int = 32) -> np.ndarray:

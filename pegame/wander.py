@@ -21,7 +21,7 @@ class Wanderer:
                  stuck_decisions: int = 2) -> None:
         self.grid = grid
         self.rng = rng
-        self.planner = Planner(grid, body.radius)
+        self.planner = Planner.shared(grid, body.radius)
         self.follower = PathFollower(body)
         self.stuck_distance = stuck_distance
         self.stuck_decisions = stuck_decisions

@@ -10,10 +10,13 @@ from scipy.ndimage import binary_dilation
 
 from pegame.api import Camera, Pose
 from pegame.geometry import (
+    _line_of_sight_reference,
     _ray_tables,
     fov_wedge,
+    grid_frame,
     in_view,
     line_of_sight,
+    point_cell,
     visibility_region,
     visibility_region_reference,
 )
@@ -138,6 +141,21 @@ def test_fast_mask_equals_reference_mask(seed):
         assert np.array_equal(fast, visibility_region_reference(grid, pose, camera))
 
 
+@pytest.mark.parametrize("yaw", [0.0, 0.5])
+def test_fast_mask_equals_reference_with_samples_on_cell_edges(yaw):
+    # A camera on a cell corner looking along a grid axis puts samples on cell edges, where
+    # multiplying by 1 / resolution and dividing by it can floor differently.
+    rng = np.random.default_rng(11)
+    grid = random_grid(rng, 120, 120, 0.05, origin=(0.0, 0.0, yaw), density=0.02)
+    camera = Camera(fov=0.2, near=0.1, far=4.0, angle_step=0.05, distance_step=0.05)
+    for _ in range(30):
+        corner = grid.cell_to_world(*rng.integers(20, 100, 2))
+        x, y = np.round(np.asarray(corner) / 0.05 - 0.5) * 0.05
+        pose = Pose(x, y, yaw + float(rng.choice([0.0, 0.5, 1.0, -0.5])) * math.pi)
+        fast = visibility_region(grid, pose, camera)
+        assert np.array_equal(fast, visibility_region_reference(grid, pose, camera))
+
+
 @pytest.mark.parametrize("region", BOTH)
 def test_camera_in_a_blocked_cell_or_off_the_map_sees_nothing(region):
     data = np.full((40, 40), FREE, dtype=np.int8)
@@ -158,6 +176,36 @@ def test_line_of_sight_is_symmetric_on_a_random_grid():
     for _ in range(200):
         a, b = random_free_pose(rng, grid), random_free_pose(rng, grid)
         assert line_of_sight(grid, a.xy, b.xy) == line_of_sight(grid, b.xy, a.xy)
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.7])
+def test_fast_line_of_sight_equals_reference(yaw):
+    rng = np.random.default_rng(8)
+    grid = random_grid(rng, 50, 40, 0.05, origin=(-1.3, 0.4, yaw), density=0.03)
+    outcomes = set()
+    for _ in range(400):
+        a, b = random_free_pose(rng, grid).xy, random_free_pose(rng, grid).xy
+        if rng.random() < 0.2:  # endpoints off the grid and on cell edges too
+            b = b + rng.choice([-3.0, 3.0], 2)
+        if rng.random() < 0.2:
+            a = np.round(a / grid.resolution) * grid.resolution
+        step = float(rng.choice([0.5 * grid.resolution, 0.013, 0.2]))
+        fast = line_of_sight(grid, a, b, step)
+        assert fast == _line_of_sight_reference(grid, a, b, step)
+        outcomes.add(fast)
+    assert outcomes == {True, False}
+
+
+def test_point_cell_matches_world_to_cell():
+    rng = np.random.default_rng(9)
+    for yaw in (0.0, -2.1):
+        grid = empty_grid(resolution=0.05, origin=(0.35, -1.2, yaw))
+        frame = grid_frame(grid)
+        # Cell edges are where a float quotient may round either way.
+        on_edges = np.round(rng.uniform(-5, 5, (500, 2)) / 0.05) * 0.05
+        xy = np.concatenate([rng.uniform(-5, 5, (500, 2)), on_edges])
+        for x, y in xy:
+            assert point_cell(x, y, frame) == grid.world_to_cell(x, y)
 
 
 def test_line_of_sight_is_broken_by_a_wall_and_blocked_endpoints():

@@ -2,18 +2,26 @@
 
 from __future__ import annotations
 
+import gc
 import math
+import pickle
+import weakref
 
 import numpy as np
 import pytest
 
 from pegame.api import STOP, Body, Pose
 from pegame.navigation import (
+    LARGE_GRID_CELLS,
+    LARGE_GRID_LANDMARKS,
     PathFollower,
     Planner,
     _astar_reference,
     _distance_field_reference,
+    _follow,
+    _follow_reference,
     inflate,
+    shared_inflation,
 )
 from pegame.maps import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
@@ -142,9 +150,10 @@ def test_distance_field_matches_reference_and_bellman_ford(seed, weighted):
 
 
 @pytest.mark.parametrize("seed", SEEDS)
-def test_plans_are_clear_optimal_and_match_the_reference(seed):
+@pytest.mark.parametrize("landmarks", [0, 3])
+def test_plans_are_clear_optimal_and_match_the_reference(seed, landmarks):
     grid = random_grid(seed)
-    planner = Planner(grid, 0.12)
+    planner = Planner(grid, 0.12, landmarks=landmarks)
     rng = np.random.default_rng(seed)
     starts, goals = random_points(rng, planner, 12), random_points(rng, planner, 12)
     for start, goal in zip(starts, goals):
@@ -251,6 +260,60 @@ def test_start_in_the_inflation_zone_still_plans():
     assert planner.nearest_traversable(start) == pytest.approx(tuple(result.path[0]))
 
 
+def test_shared_planners_and_masks_are_built_once_per_grid_and_parameters():
+    grid, other = random_grid(0), random_grid(1)
+    planner = Planner.shared(grid, 0.1)
+    assert Planner.shared(grid, 0.1, margin=0.05) is planner  # defaults count as given
+    assert Planner.shared(grid, 0.1, margin=0.1) is not planner
+    assert Planner.shared(grid, 0.2) is not planner and Planner.shared(other, 0.1) is not planner
+    fresh = Planner(grid, 0.1)
+    np.testing.assert_array_equal(planner.traversable, fresh.traversable)
+    np.testing.assert_array_equal(planner.multipliers, fresh.multipliers)
+    assert not planner.traversable.flags.writeable and not planner.multipliers.flags.writeable
+    mask = shared_inflation(grid, 0.1)
+    assert shared_inflation(grid, 0.1) is mask and not mask.flags.writeable
+    np.testing.assert_array_equal(mask, inflate(grid, 0.1))
+    assert inflate(grid, 0.1).flags.writeable
+
+
+def test_landmarks_by_default_only_on_large_grids():
+    assert Planner(random_grid(0), 0.1).landmarks == 0  # the paper's maps keep the octile heuristic
+    large = OccupancyGrid(np.zeros((1000, LARGE_GRID_CELLS // 1000), dtype=np.int8), 0.05)
+    assert Planner(large, 0.1).landmarks == LARGE_GRID_LANDMARKS
+    assert Planner(large, 0.1, landmarks=0).landmarks == 0
+
+
+def test_the_shared_cache_lives_and_dies_with_its_grid():
+    grid = random_grid(0)
+    planner = Planner.shared(grid, 0.1)
+    copied = pickle.loads(pickle.dumps(grid))  # the cache is not pickled along
+    assert Planner.shared(copied, 0.1) is not planner and Planner.shared(copied, 0.1).grid is copied
+    alive = weakref.ref(grid)
+    del grid, planner
+    gc.collect()
+    assert alive() is None
+
+
+def test_searches_leave_no_state_behind():
+    # A shared planner reuses scratch memory between searches: any order of searches must
+    # give what a fresh planner gives.
+    grid = random_grid(3)
+    shared = Planner(grid, 0.1)
+    rng = np.random.default_rng(3)
+    points = random_points(rng, shared, 20) + [(-1.0, 0.5), (1.0, 1.0), (50.0, 2.0)]
+    for _ in range(40):
+        a, b = (points[i] for i in rng.integers(0, len(points), 2))
+        if rng.random() < 0.3:
+            weighted = bool(rng.random() < 0.5)
+            np.testing.assert_array_equal(
+                shared.distance_field(a, weighted), Planner(grid, 0.1).distance_field(a, weighted)
+            )
+        ours, theirs = shared.plan(a, b), Planner(grid, 0.1).plan(a, b)
+        assert (ours.reachable, ours.reason) == (theirs.reachable, theirs.reason)
+        assert ours.cost == theirs.cost or not ours.reachable
+        np.testing.assert_array_equal(ours.path, theirs.path)
+
+
 def test_reachable_and_nearest_traversable():
     planner = Planner(walled_room_grid(), 0.1)
     outside, room = planner.reachable((0.5, 0.5)), planner.reachable((2.95, 1.55))
@@ -302,6 +365,25 @@ def distance_to_polyline(point, path):
     d = b - a
     t = np.clip(np.einsum("ij,ij->i", point - a, d) / np.einsum("ij,ij->i", d, d), 0, 1)
     return np.hypot(*(a + t[:, None] * d - point).T).min()
+
+
+def test_follower_kernel_equals_reference():
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        count = int(rng.integers(1, 40))
+        signs = rng.choice([-1.0, 1.0], size=(count, 2))
+        steps = rng.choice([0.0, 0.05, 0.0707], size=(count, 1)) * signs
+        path = np.cumsum(steps, axis=0) + rng.uniform(-2, 2, 2)
+        if count > 3 and rng.random() < 0.3:
+            path[-3:] = path[:3][::-1]  # a path passing near itself
+        seg = np.diff(path, axis=0)
+        seg_len = np.hypot(seg[:, 0], seg[:, 1])
+        arc = np.concatenate([[0.0], np.cumsum(seg_len)])
+        progress = float(rng.uniform(0.0, arc[-1] + 0.2))
+        x, y = path[int(rng.integers(count))] + rng.normal(0.0, 0.1, 2)
+        lookahead = float(rng.choice([0.05, 0.5, 2.0]))
+        args = (path, seg_len, arc, progress, lookahead, x, y)
+        assert _follow(*args) == _follow_reference(*args)
 
 
 def test_follower_tracks_an_l_shaped_path_within_limits():

@@ -26,7 +26,16 @@ from pegame.api import (
 )
 from pegame.errors import ConfigError
 from pegame.maps import FREE, OCCUPIED, OccupancyGrid
-from pegame.pursuers.smart import SEARCH, SCAN, TRACK, SmartPursuer
+from pegame.geometry import grid_frame
+from pegame.navigation import inflate
+from pegame.pursuers.smart import (
+    SCAN,
+    SEARCH,
+    TRACK,
+    SmartPursuer,
+    _straight_clear,
+    _straight_clear_reference,
+)
 from pegame.registry import make_config
 
 RES = 0.1  # m per cell
@@ -148,6 +157,28 @@ def test_commanded_tracking_never_enters_the_inflated_wall():
         row, col = pursuer.context.grid.world_to_cell(pose.x, pose.y)
         assert not pursuer.blocked[row, col]
     assert pose.x > 3.0  # it did approach
+
+
+@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (0.4, -1.3, 0.8)])
+def test_fast_look_ahead_check_equals_reference(origin):
+    data = np.full((40, 50), FREE, dtype=np.int8)
+    data[10:30, 20:24] = OCCUPIED
+    grid = OccupancyGrid(data, RES, origin)
+    blocked = inflate(grid, RADIUS)
+    frame = grid_frame(grid)
+    rng = np.random.default_rng(4)
+    outcomes = set()
+    for _ in range(2000):
+        x, y = grid.cell_to_world(*rng.integers(-2, 42, 2))
+        if rng.random() < 0.5:
+            x, y = x + rng.uniform(-0.05, 0.05), y + rng.uniform(-0.05, 0.05)
+        theta = rng.uniform(-math.pi, math.pi)
+        distance = rng.choice([-1.0, 1.0]) * rng.uniform(0.01, 1.5)
+        n = max(1, math.ceil(2 * abs(distance) / RES))
+        fast = _straight_clear(blocked, x, y, math.cos(theta), math.sin(theta), distance, n, frame)
+        assert fast == _straight_clear_reference(grid, blocked, x, y, theta, distance, n)
+        outcomes.add(fast)
+    assert outcomes == {True, False}
 
 
 # ------------------------------------------------------------------------ searching

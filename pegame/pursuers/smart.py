@@ -24,6 +24,9 @@ the weighted mean of the particles (``observation.belief.mean``, map frame, m), 
 follows the path; it replans at every decision and at once when it loses the evader.
 Once there, or when there is no reachable estimate, it rotates in place to scan for
 the evader. A detection switches back to tracking at the next control tick.
+
+The look-ahead collision check runs every tracking tick, so it is a numba kernel
+(:func:`_straight_clear`) with the numpy reference ``_straight_clear_reference``.
 """
 
 from __future__ import annotations
@@ -33,10 +36,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from pegame.api import Plan, Pose, Pursuer, PursuerObservation, Velocity, wrap_angle
 from pegame.errors import require
-from pegame.navigation import PathFollower, Planner, inflate
+from pegame.geometry import grid_frame, point_cell
+from pegame.maps import OccupancyGrid
+from pegame.navigation import PathFollower, Planner, shared_inflation
 
 log = logging.getLogger(__name__)
 
@@ -68,9 +74,10 @@ class SmartPursuer(Pursuer):
 
     def __init__(self, config, context, rng) -> None:
         super().__init__(config, context, rng)
-        self.planner = Planner(context.grid, context.pursuer.radius)
+        self.planner = Planner.shared(context.grid, context.pursuer.radius)
         self.follower = PathFollower(context.pursuer)
-        self.blocked = inflate(context.grid, context.pursuer.radius)
+        self.blocked = shared_inflation(context.grid, context.pursuer.radius)
+        self._frame = grid_frame(context.grid)
         self.reset(Pose(0.0, 0.0))
 
     def reset(self, pose: Pose) -> None:
@@ -128,21 +135,13 @@ class SmartPursuer(Pursuer):
 
     def _clear(self, pose: Pose, distance: float) -> bool:
         """True when moving ``distance`` m straight along the heading (negative: backwards)
-        from ``pose`` stays on the grid and out of inflated obstacle cells.
-
-        Samples are half a cell apart so no thin wall is skipped. The cell the robot is in
-        does not count: a robot whose centre already touches the inflation zone (possible in
-        a continuous simulator) must still be able to move out of it.
-        """
-        grid = self.context.grid
-        n = max(1, math.ceil(2 * abs(distance) / grid.resolution))
-        s = np.linspace(distance / n, distance, n)
-        rows, cols = grid.world_to_cell(pose.x + s * math.cos(pose.theta), pose.y + s * math.sin(pose.theta))
-        if not grid.contains(rows, cols).all():
-            return False
-        here = grid.world_to_cell(pose.x, pose.y)
-        elsewhere = (rows != here[0]) | (cols != here[1])
-        return not self.blocked[rows[elsewhere], cols[elsewhere]].any()
+        from ``pose`` stays on the grid and out of inflated obstacle cells (see
+        :func:`_straight_clear`)."""
+        theta = pose.theta
+        n = max(1, math.ceil(2 * abs(distance) / self.context.grid.resolution))
+        return _straight_clear(
+            self.blocked, pose.x, pose.y, math.cos(theta), math.sin(theta), distance, n, self._frame
+        )
 
     # -- searching
 
@@ -183,3 +182,39 @@ class SmartPursuer(Pursuer):
 
 def _clamp(value: float, limit: float) -> float:
     return max(-limit, min(limit, value))
+
+
+@njit(cache=True)
+def _straight_clear(blocked, x, y, cos_theta, sin_theta, distance, n, frame):
+    """True when the n samples at ``np.linspace(distance / n, distance, n)`` m along the
+    heading (cos_theta, sin_theta) from (x, y) (map frame, m) are all on the grid and, except
+    those in the start's own cell, out of the bool (H, W) mask ``blocked``.
+
+    Samples are half a cell apart (the caller's n) so no thin wall is skipped. The start's
+    cell does not count: a robot whose centre already touches the inflation zone (possible
+    in a continuous simulator) must still be able to move out of it. The sample distances
+    repeat np.linspace's arithmetic, so the result equals ``_straight_clear_reference``.
+    """
+    height, width = blocked.shape
+    here = point_cell(x, y, frame)
+    start = distance / n
+    step = (distance - start) / (n - 1) if n > 1 else 0.0
+    for k in range(n):
+        s = distance if k == n - 1 else k * step + start
+        row, col = point_cell(x + s * cos_theta, y + s * sin_theta, frame)
+        if not (0 <= row < height and 0 <= col < width):
+            return False
+        if (row, col) != here and blocked[row, col]:
+            return False
+    return True
+
+
+def _straight_clear_reference(grid: OccupancyGrid, blocked, x, y, theta, distance, n) -> bool:
+    """Plain numpy reference of :func:`_straight_clear` (heading ``theta`` rad)."""
+    s = np.linspace(distance / n, distance, n)
+    rows, cols = grid.world_to_cell(x + s * math.cos(theta), y + s * math.sin(theta))
+    if not grid.contains(rows, cols).all():
+        return False
+    here = grid.world_to_cell(x, y)
+    elsewhere = (rows != here[0]) | (cols != here[1])
+    return not blocked[rows[elsewhere], cols[elsewhere]].any()

@@ -5,6 +5,9 @@ limits and integrated exactly over dt (arc motion). An agent never enters a cell
 grid inflated by its radius (:func:`pegame.navigation.inflate`): a move that would enter
 one is cut at the last free sample, so the agent stops at the wall and may still turn.
 The agents do not collide with each other (the paper's agents never need to touch).
+
+The swept collision check is a numba kernel (:func:`_sweep`); ``_sweep_reference`` is the
+plain-Python loop it reproduces, which the tests compare it against.
 """
 
 from __future__ import annotations
@@ -12,17 +15,21 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
+from numba import njit
 
 from pegame.api import Body, Pose, SensorFrame, Simulator, Velocity, wrap_angle
-from pegame.navigation import inflate
+from pegame.geometry import cell_blocked, grid_frame, point_cell
+from pegame.navigation import shared_inflation
 
 
 def saturate(cmd: Velocity, body: Body) -> Velocity:
     """Clip a command to |v| <= v_max (m/s) and |w| <= w_max (rad/s)."""
-    return Velocity(
-        float(np.clip(cmd.v, -body.v_max, body.v_max)), float(np.clip(cmd.w, -body.w_max, body.w_max))
-    )
+    return Velocity(_clip(cmd.v, body.v_max), _clip(cmd.w, body.w_max))
+
+
+def _clip(value: float, limit: float) -> float:
+    """``value`` clipped to [-limit, limit]; like np.clip, NaN stays NaN."""
+    return float(min(max(value, -limit), limit))
 
 
 def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
@@ -37,31 +44,54 @@ def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
     return Pose(pose.x + dx, pose.y + dy, wrap_angle(theta))
 
 
+@njit(cache=True)
+def _sweep(blocked, sx, sy, tx, ty, n, frame):
+    """The last of the points k/n along the chord from (sx, sy) to (tx, ty) (m, map frame),
+    k = 1..n, before the first one whose cell is off the grid or True in ``blocked``;
+    (sx, sy) when that is the first. ``frame``: :func:`pegame.geometry.grid_frame`."""
+    x, y = sx, sy
+    for k in range(1, n + 1):
+        nx = sx + (tx - sx) * k / n
+        ny = sy + (ty - sy) * k / n
+        row, col = point_cell(nx, ny, frame)
+        if cell_blocked(blocked, row, col):
+            break
+        x, y = nx, ny
+    return x, y
+
+
+def _sweep_reference(grid, blocked, sx, sy, tx, ty, n):
+    """Plain-Python reference of :func:`_sweep` on ``grid``."""
+    x, y = sx, sy
+    for k in range(1, n + 1):
+        nx = sx + (tx - sx) * k / n
+        ny = sy + (ty - sy) * k / n
+        row, col = grid.world_to_cell(nx, ny)
+        if not grid.contains(row, col) or blocked[row, col]:
+            break
+        x, y = nx, ny
+    return x, y
+
+
 class _Agent:
-    """One agent's body, its collision mask and its pose."""
+    """One agent's body, its collision mask (shared, read-only) and its pose."""
 
     def __init__(self, grid, body: Body) -> None:
         self.grid = grid
         self.body = body
-        self.blocked = inflate(grid, body.radius)
+        self.blocked = shared_inflation(grid, body.radius)
+        self.frame = grid_frame(grid)
         self.pose = Pose(0.0, 0.0, 0.0)
 
     def collides(self, x: float, y: float) -> bool:
-        row, col = self.grid.world_to_cell(x, y)
-        return not self.grid.contains(row, col) or bool(self.blocked[row, col])
+        return cell_blocked(self.blocked, *point_cell(x, y, self.frame))
 
     def move(self, cmd: Velocity, dt: float) -> None:
-        target = unicycle(self.pose, saturate(cmd, self.body), dt)
-        # Sample the chord at half-cell spacing so that no move skips over a thin wall.
         start = self.pose
+        target = unicycle(start, saturate(cmd, self.body), dt)
+        # Sample the chord at half-cell spacing so that no move skips over a thin wall.
         n = max(1, math.ceil(2 * start.distance_to(target) / self.grid.resolution))
-        x, y = start.x, start.y
-        for k in range(1, n + 1):
-            nx = start.x + (target.x - start.x) * k / n
-            ny = start.y + (target.y - start.y) * k / n
-            if self.collides(nx, ny):
-                break
-            x, y = nx, ny
+        x, y = _sweep(self.blocked, start.x, start.y, target.x, target.y, n, self.frame)
         self.pose = Pose(x, y, target.theta)
 
 

@@ -1,0 +1,112 @@
+"""Tests for pegame.sims.grid: unicycle integration, saturation and swept wall collisions."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pegame.api import Body, Camera, Context, Pose, Velocity
+from pegame.geometry import grid_frame
+from pegame.maps import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from pegame.navigation import inflate
+from pegame.sims.grid import GridSimulator, _sweep, _sweep_reference, saturate, unicycle
+
+PURSUER = Body(radius=0.2, v_max=0.5, w_max=1.8)
+EVADER = Body(radius=0.25, v_max=0.5, w_max=1.8)
+DT = 0.1
+
+
+def room(origin=(0.0, 0.0, 0.0)):
+    """A 4 m x 3 m walled room (0.05 m cells) with a pillar and a few unknown cells."""
+    data = np.full((60, 80), FREE, dtype=np.int8)
+    data[[0, -1], :] = OCCUPIED
+    data[:, [0, -1]] = OCCUPIED
+    data[25:35, 35:45] = OCCUPIED
+    data[10, 60:63] = UNKNOWN
+    return OccupancyGrid(data, 0.05, origin)
+
+
+def simulator(grid):
+    context = Context(grid, PURSUER, EVADER, Camera(), DT, 1.0)
+    return GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
+
+
+def test_saturate_clips_to_the_body_limits():
+    assert saturate(Velocity(2.0, -5.0), PURSUER) == Velocity(0.5, -1.8)
+    assert saturate(Velocity(-0.3, 0.4), PURSUER) == Velocity(-0.3, 0.4)
+    assert math.isnan(saturate(Velocity(math.nan, 0.0), PURSUER).v)
+
+
+def test_free_motion_is_the_exact_unicycle_arc():
+    sim = simulator(room())
+    start = Pose(1.0, 1.0, 0.3)
+    sim.reset(start, Pose(3.5, 2.5))
+    for cmd in (Velocity(0.4, 0.0), Velocity(0.4, 1.0), Velocity(-0.2, -0.5)):
+        sim.step(cmd, Velocity(), DT)
+        expected = unicycle(start, cmd, DT)
+        assert sim.poses[0] == expected
+        start = expected
+    # Closed form of the arc: centre at distance v / w to the left of the heading.
+    v, w, theta = 0.4, 1.0, 0.3
+    moved = unicycle(Pose(0.0, 0.0, theta), Velocity(v, w), 1.0)
+    cx, cy = -v / w * math.sin(theta), v / w * math.cos(theta)
+    assert math.hypot(moved.x - cx, moved.y - cy) == pytest.approx(v / w)
+    assert moved.theta == pytest.approx(theta + w)
+
+
+def test_an_agent_stops_at_a_wall_and_can_still_turn():
+    grid = room()
+    sim = simulator(grid)
+    sim.reset(Pose(1.0, 1.5, 0.0), Pose(3.5, 2.5))  # heading at the pillar's left face x = 1.75
+    for _ in range(40):
+        sim.step(Velocity(0.5, 0.0), Velocity(), DT)
+    stopped = sim.poses[0]
+    assert 1.75 - PURSUER.radius - 0.05 <= stopped.x <= 1.75 - PURSUER.radius and stopped.y == 1.5
+    sim.step(Velocity(0.5, 1.0), Velocity(), DT)
+    assert sim.poses[0].theta == pytest.approx(0.1)
+
+
+@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-1.2, 0.7, 0.4)])
+def test_random_commands_never_enter_inflated_cells(origin):
+    grid = room(origin)
+    sim = simulator(grid)
+    rng = np.random.default_rng(1)
+    sim.reset(Pose(*grid.cell_to_world(10, 10)), Pose(*grid.cell_to_world(50, 70)))
+    masks = inflate(grid, PURSUER.radius), inflate(grid, EVADER.radius)
+    moved = 0.0
+    for _ in range(3000):
+        before = sim.poses
+        commands = [Velocity(*rng.uniform(-1.0, 1.0, 2) * [0.8, 3.0]) for _ in range(2)]
+        sim.step(*commands, DT)
+        for pose, old, mask in zip(sim.poses, before, masks):
+            row, col = grid.world_to_cell(pose.x, pose.y)
+            assert grid.contains(row, col) and not mask[row, col]
+            moved += pose.distance_to(old)
+    assert moved > 50.0  # the agents did get around
+
+
+def test_fast_sweep_equals_reference():
+    rng = np.random.default_rng(2)
+    for origin in [(0.0, 0.0, 0.0), (0.3, -0.2, 1.1)]:
+        grid = room(origin)
+        blocked = inflate(grid, PURSUER.radius)
+        frame = grid_frame(grid)
+        stops = 0
+        for _ in range(2000):
+            sx, sy = rng.uniform(-0.5, 4.5), rng.uniform(-0.5, 3.5)
+            if rng.random() < 0.3:  # starts and ends on cell edges
+                sx, sy = round(sx / 0.05) * 0.05, round(sy / 0.05) * 0.05
+            tx, ty = sx + rng.normal(0.0, 0.3), sy + rng.normal(0.0, 0.3)
+            n = int(rng.integers(1, 20))
+            fast = _sweep(blocked, sx, sy, tx, ty, n, frame)
+            assert fast == _sweep_reference(grid, blocked, sx, sy, tx, ty, n)
+            stops += fast != (tx, ty)
+        assert 100 < stops < 2000
+
+
+def test_start_inside_an_obstacle_is_refused():
+    sim = simulator(room())
+    with pytest.raises(ValueError, match="inside an obstacle"):
+        sim.reset(Pose(0.1, 1.0), Pose(3.5, 2.5))
