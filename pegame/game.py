@@ -82,8 +82,8 @@ def spawn(context: Context, rng: np.random.Generator, attempts: int = 500) -> tu
     Raises SpawnError when ``attempts`` pursuer draws give no valid pair.
     """
     grid, camera = context.grid, context.camera
-    pursuer_space = Planner(grid, context.pursuer.radius).traversable
-    evader_space = Planner(grid, context.evader.radius).traversable
+    pursuer_space = Planner.shared(grid, context.pursuer.radius).traversable
+    evader_space = Planner.shared(grid, context.evader.radius).traversable
     rows, cols = np.nonzero(pursuer_space)
     for _ in range(attempts if rows.size else 0):
         k = int(rng.integers(rows.size))

@@ -321,10 +321,10 @@ class SmartEvader(Evader):
     def __init__(self, config, context, rng) -> None:
         super().__init__(config, context, rng)
         grid = context.grid
-        self.planner = Planner(grid, context.evader.radius)
+        self.planner = Planner.shared(grid, context.evader.radius)
         # The pursuer's planner only serves its geodesic distance field.
         self.pursuer_planner = (
-            Planner(grid, context.pursuer.radius) if config.distance == "geodesic" else None
+            Planner.shared(grid, context.pursuer.radius) if config.distance == "geodesic" else None
         )
         self.follower = PathFollower(context.evader)
         rows, cols = np.indices(grid.data.shape)
