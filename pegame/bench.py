@@ -207,6 +207,34 @@ def recorder_cost(games: int, out_dir: str) -> tuple[float | None, float | None]
     return recorded / plain - 1.0, (max(sizes) / 2**20 if sizes else None)
 
 
+def env_steps_per_second(seconds: float) -> float | None:
+    """PettingZoo env steps per second with random actions (null without pettingzoo)."""
+    try:
+        from pegame.envs import bench_steps_per_second
+    except ImportError:
+        return None
+    return bench_steps_per_second(seconds=seconds)["steps_per_s"]
+
+
+def plugin_figures(quick: bool) -> dict[str, float | None]:
+    """The 3D plugins' figures: pybullet real-time factor of a 90 s S-S game (camera at
+    10 Hz, 160x120) and the vision detector's precision and recall against segmentation;
+    null when the plugin distributions are not installed."""
+    figures: dict[str, float | None] = dict.fromkeys(("pybullet_rtf", "vision_precision", "vision_recall"))
+    try:
+        from pegame_pybullet.bench import rtf
+    except ImportError:
+        return figures
+    figures["pybullet_rtf"] = rtf(t_max=30.0 if quick else 90.0)["rtf"]
+    try:
+        from pegame_vision.evaluate import evaluate
+    except ImportError:
+        return figures
+    scores = evaluate(seeds=range(1) if quick else range(3), t_max=30.0 if quick else 60.0)
+    figures["vision_precision"], figures["vision_recall"] = scores["vision_precision"], scores["vision_recall"]
+    return figures
+
+
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     parser = argparse.ArgumentParser(prog="python -m pegame.bench", description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -245,8 +273,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         report["ss_games_per_s"] = games_per_second(ss, games, tmp) if smart else None
         report["recorder_overhead"], report["rrd_mb_per_game"] = recorder_cost(games, tmp)
     report["large_map_decision_ms"], report["large_map_peak_mb"] = large_map_decision(max(5, repeat // 10))
-    for key in ("pybullet_rtf", "vision_precision", "vision_recall", "env_steps_per_s"):
-        report.setdefault(key, None)
+    report["env_steps_per_s"] = env_steps_per_second(2 if args.quick else 10)
+    report.update(plugin_figures(args.quick))
     report["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
     if args.json:
@@ -279,6 +307,9 @@ def format_report(report: dict[str, Any]) -> str:
     overhead = report["recorder_overhead"]
     lines.append(f"recorder: +{fmt(None if overhead is None else 100 * overhead)}% game time, "
                  f"{fmt(report['rrd_mb_per_game'])} MB per 90 s game")
+    lines.append(f"env steps/s (PettingZoo, random actions): {fmt(report['env_steps_per_s'])}")
+    lines.append(f"pybullet S-S real-time factor: {fmt(report['pybullet_rtf'])}; vision vs segmentation: "
+                 f"precision {fmt(report['vision_precision'])}, recall {fmt(report['vision_recall'])}")
     lines.append(f"warehouse 1000x1667 cells: {fmt(report['large_map_decision_ms'])} ms per decision tick, "
                  f"peak {fmt(report['large_map_peak_mb'])} MB")
     return "\n".join(lines)

@@ -1,0 +1,45 @@
+"""Reinforcement-learning environments on pegame's games.
+
+- :func:`parallel_env` - PettingZoo Parallel env, agents ``pursuer`` and ``evader``
+  (:mod:`pegame.envs.parallel`);
+- ``gymnasium.make("pegame/Pursuit-v0")`` and ``"pegame/Evasion-v0"`` - one learner
+  against a pegame strategy (:mod:`pegame.envs.single`), registered when this package is
+  imported (or ``gymnasium.make("pegame.envs:pegame/Pursuit-v0")``);
+- :func:`bench_steps_per_second` - the env's speed, for ``python -m pegame.bench``.
+
+Every env takes the app's config (``config=`` a composed DictConfig, or ``overrides=``
+the command-line overrides: any map, simulator, detector, estimator, opponent) and the
+options of :class:`pegame.envs.settings.EnvSettings`. Observations
+(:mod:`pegame.envs.observations`) are shared with the ``policy`` pursuer and evader,
+which play a trained policy in ordinary games.
+
+The env classes need gymnasium and pettingzoo (``pip install pegame[rl]``); the
+observation code does not. The PettingZoo env is imported on first use.
+"""
+
+from __future__ import annotations
+
+import importlib
+from importlib.util import find_spec
+
+_LAZY = {
+    "parallel_env": "pegame.envs.parallel",
+    "PursuitEvasionParallelEnv": "pegame.envs.parallel",
+    "PursuitEnv": "pegame.envs.single",
+    "EvasionEnv": "pegame.envs.single",
+    "register_envs": "pegame.envs.single",
+    "bench_steps_per_second": "pegame.envs.bench",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'pegame.envs' has no attribute '{name}'")
+
+
+# Gymnasium 1.x has no plugin entry points: env ids exist once their package is imported.
+if find_spec("gymnasium") is not None:
+    importlib.import_module("pegame.envs.single").register_envs()

@@ -1,0 +1,127 @@
+"""The environments' shared core: observations, actions, rewards and infos of one or two
+learning roles around a :class:`pegame.envs.match.Match`.
+
+A step applies the learners' actions for ``ticks_per_action`` control ticks (the
+decision period) while the other role, if any, plays its strategy. Reward: the pursuer
+gets +1 for every control tick reached during the step at which its detector reports the
+evader, the evader the negative (zero-sum). The game ends after ``game.t_max`` s: the
+last step is a truncation (there is no terminal state); a last step may be shorter when
+t_max is not a whole number of decision periods.
+
+Infos: ``seed`` (the episode's master seed; ``python -m pegame game.seed=<seed>`` with
+the same strategies replays it) after reset; ``time`` (s) and ``tracking_rate`` (the
+fraction of the ticks played so far with the evader detected, as in the game's result)
+after every step; and at the end ``metrics``, the game's
+:meth:`pegame.metrics.TrackingMetrics.summary`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+from omegaconf import DictConfig
+
+from pegame.envs.actions import to_velocity
+from pegame.envs.match import Match
+from pegame.envs.observations import EvaderFeatures, PursuerFeatures
+from pegame.envs.settings import EnvSettings
+
+
+def check_seed(seed: int | None) -> int | None:
+    """``seed`` if it is None or a non-negative integer, else ValueError."""
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
+        raise ValueError(f"seed must be a non-negative integer or None, got {seed!r}.")
+    return seed
+
+
+def episode_seed(seed: int | None, rng: np.random.Generator) -> int:
+    """``seed`` itself when given (checked), else a fresh one drawn from ``rng``."""
+    return int(rng.integers(2**63 - 1)) if check_seed(seed) is None else int(seed)
+
+
+class Episode:
+    """The learning ``roles`` (a subset of ('pursuer', 'evader')) in games of ``cfg``."""
+
+    def __init__(self, cfg: DictConfig, settings: EnvSettings, roles: Sequence[str]) -> None:
+        self.settings = settings
+        self.roles = tuple(roles)
+        self.match = Match(cfg, self.roles, belief=settings.belief)
+        context = self.match.context
+        self.ticks_per_action = settings.ticks_per_action(context.control_dt)
+        self.features = {
+            "pursuer": PursuerFeatures(context, settings.observation),
+            "evader": EvaderFeatures(context, settings.observation),
+        }
+        self.bodies = {"pursuer": context.pursuer, "evader": context.evader}
+        self.seed: int | None = None
+
+    @property
+    def steps(self) -> int:
+        """Steps in one episode."""
+        return -(-self.match.ticks // self.ticks_per_action)
+
+    def reset(self, seed: int) -> dict[str, np.ndarray]:
+        """Start an episode with master seed ``seed``; the learners' first observations."""
+        self.seed = seed
+        self.match.start(seed)
+        for role in self.roles:
+            self.features[role].reset()
+        self._remember()
+        return self.observations()
+
+    def step(self, actions: Mapping[str, object]) -> tuple[dict[str, np.ndarray], float, bool]:
+        """Apply the learners' ``actions`` (role -> scaled (v, w)) for one decision period.
+
+        Returns the new observations, the pursuer's reward (the evader's is its negative)
+        and whether the game is over. Every action is checked before anything moves.
+        """
+        if self.seed is None or self.match.done:
+            raise RuntimeError("No game in progress: call reset() before step().")
+        commands = self._commands(actions)
+        detections = 0
+        for _ in range(self.ticks_per_action):
+            detections += self.match.advance(commands["pursuer"], commands["evader"])
+            self._remember()
+            if self.match.done:
+                break
+        return self.observations(), float(detections), self.match.done
+
+    def observations(self) -> dict[str, np.ndarray]:
+        """Each learner's observation at the current tick (new arrays)."""
+        m, out = self.match, {}
+        if "pursuer" in self.roles:
+            out["pursuer"] = self.features["pursuer"].build(m.time, m.pursuer, m.belief)
+        if "evader" in self.roles:
+            out["evader"] = self.features["evader"].build(m.evader, m.pursuer)
+        return out
+
+    def info(self) -> dict:
+        """The step's info (see the module docstring); a new dict each call."""
+        m = self.match
+        info = {"time": m.time, "tracking_rate": m.tracking_rate}
+        if m.done:
+            info["metrics"] = m.metrics.summary()
+        return info
+
+    def _remember(self) -> None:
+        if "pursuer" in self.roles:
+            self.features["pursuer"].remember(self.match.time, self.match.detection)
+
+    def _commands(self, actions: Mapping[str, object]) -> dict:
+        if not isinstance(actions, Mapping):
+            raise ValueError(f"actions must map each agent in {list(self.roles)} to its action, got {actions!r}.")
+        unknown = sorted(set(actions) - set(self.roles))
+        missing = [role for role in self.roles if role not in actions]
+        if unknown or missing:
+            raise ValueError(
+                f"actions must have exactly the agents {list(self.roles)}; "
+                f"missing {missing}, unexpected {unknown}."
+            )
+        commands = {"pursuer": None, "evader": None}
+        for role in self.roles:
+            commands[role] = to_velocity(actions[role], self.bodies[role], self.settings.clip_actions, f"{role} action")
+        return commands
+
+    def close(self) -> None:
+        self.match.close()

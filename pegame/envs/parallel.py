@@ -1,0 +1,81 @@
+"""The two-agent PettingZoo environment: a learning pursuer against a learning evader.
+
+Agents ``pursuer`` and ``evader`` act simultaneously (PettingZoo's Parallel API).
+Spaces, per agent: ``Box(-1, 1, (2,), float32)`` actions (v, w) scaled to the agent's
+limits (:mod:`pegame.envs.actions`) and a flat float32 ``Box`` observation
+(:mod:`pegame.envs.observations`; ``env.layouts[agent]`` names its parts). Rewards,
+infos and episode length: :mod:`pegame.envs.core`. Both agents are truncated together
+when the game's ``t_max`` is reached.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from gymnasium import spaces
+from omegaconf import DictConfig
+from pettingzoo import ParallelEnv
+
+from pegame.envs.core import Episode, check_seed, episode_seed
+from pegame.envs.match import ROLES
+from pegame.envs.settings import env_config, env_settings
+
+
+class PursuitEvasionParallelEnv(ParallelEnv):
+    """Pursuer vs evader, both learning, on any map and config of the app.
+
+    config: a composed run config (``pegame.config.compose`` or a Hydra app's), or None to
+    compose one from ``overrides`` (the app's command-line overrides, e.g.
+    ``["env=hall", "game.t_max=30"]``). The ``pursuer`` and ``evader`` nodes give the
+    bodies only; the config's ``game.seed`` is not used: seed with ``reset(seed=...)``.
+    settings: :class:`pegame.envs.settings.EnvSettings` fields (decision_period,
+    crop_cells, crop_resolution, belief, clip_actions).
+    """
+
+    metadata = {"name": "pegame_pursuit_evasion_v0", "render_modes": []}
+
+    def __init__(self, config: DictConfig | None = None, overrides: Sequence[str] = (), **settings) -> None:
+        self.settings = env_settings(**settings)
+        self.episode = Episode(env_config(config, overrides), self.settings, ROLES)
+        self.possible_agents = list(ROLES)
+        self.agents: list[str] = []
+        features = self.episode.features
+        self.layouts = {role: features[role].layout for role in ROLES}
+        self.observation_spaces = {
+            role: spaces.Box(features[role].low, features[role].high, dtype=np.float32) for role in ROLES
+        }
+        self.action_spaces = {role: spaces.Box(-1.0, 1.0, (2,), np.float32) for role in ROLES}
+        self._np_random: np.random.Generator | None = None
+
+    def observation_space(self, agent: str) -> spaces.Box:
+        return self.observation_spaces[agent]
+
+    def action_space(self, agent: str) -> spaces.Box:
+        return self.action_spaces[agent]
+
+    def reset(self, seed: int | None = None, options: dict | None = None):
+        """Start a game. ``seed`` re-seeds the env: the game with master seed ``seed``, and
+        later seedless resets draw their seeds from it; never seeded, seeds are random."""
+        if seed is not None or self._np_random is None:
+            self._np_random = np.random.default_rng(check_seed(seed))
+        obs = self.episode.reset(episode_seed(seed, self._np_random))
+        self.agents = list(ROLES)
+        return obs, {role: {"seed": self.episode.seed} for role in ROLES}
+
+    def step(self, actions: dict[str, np.ndarray]):
+        """One decision period with both agents' actions (ValueError for a bad one)."""
+        obs, reward, done = self.episode.step(actions)
+        rewards = {"pursuer": reward, "evader": -reward}
+        infos = {role: self.episode.info() for role in ROLES}
+        if done:
+            self.agents = []
+        return obs, rewards, dict.fromkeys(ROLES, False), dict.fromkeys(ROLES, done), infos
+
+    def close(self) -> None:
+        self.episode.close()
+
+
+def parallel_env(config: DictConfig | None = None, overrides: Sequence[str] = (), **settings) -> PursuitEvasionParallelEnv:
+    """The PettingZoo Parallel environment (see :class:`PursuitEvasionParallelEnv`)."""
+    return PursuitEvasionParallelEnv(config, overrides, **settings)

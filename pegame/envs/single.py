@@ -1,0 +1,89 @@
+"""Single-agent Gymnasium environments: ``pegame/Pursuit-v0`` (the learner pursues) and
+``pegame/Evasion-v0`` (the learner evades) against a pegame strategy.
+
+Spaces: ``Box(-1, 1, (2,), float32)`` actions (v, w) scaled to the learner's limits
+(:mod:`pegame.envs.actions`) and a flat float32 ``Box`` observation
+(:mod:`pegame.envs.observations`; ``env.unwrapped.layout`` names its parts). Rewards,
+infos and episode length: :mod:`pegame.envs.core`; the end of the game is a truncation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import ClassVar
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+from omegaconf import DictConfig
+
+from pegame.envs.core import Episode, check_seed, episode_seed
+from pegame.envs.settings import env_config, env_settings
+
+PURSUIT_ID = "pegame/Pursuit-v0"
+EVASION_ID = "pegame/Evasion-v0"
+
+
+class _SingleAgentEnv(gymnasium.Env):
+    """The learner plays ``role``; the other role is the strategy ``opponent``.
+
+    config: a composed run config, or None to compose one from ``overrides`` (the app's
+    command-line overrides, e.g. ``["env=hall", "estimator=kalman"]``). opponent: the
+    registry name of the other role's strategy (``smart``, ``random`` or any registered
+    plugin); None keeps the config's choice (``smart`` by default); with overrides it
+    adds ``<role>=<opponent>``, with a config it must match it. The config's ``game.seed``
+    is not used: seed with ``reset(seed=...)``. settings: :class:`EnvSettings` fields.
+    """
+
+    role: ClassVar[str]
+    metadata = {"render_modes": []}
+
+    def __init__(
+        self, config: DictConfig | None = None, overrides: Sequence[str] = (), opponent: str | None = None,
+        **settings,
+    ) -> None:
+        self.settings = env_settings(**settings)
+        other = "evader" if self.role == "pursuer" else "pursuer"
+        cfg = env_config(config, overrides, {other: opponent} if opponent is not None else None)
+        self.episode = Episode(cfg, self.settings, (self.role,))
+        self.opponent = str(cfg[other].name)
+        features = self.episode.features[self.role]
+        self.layout = features.layout
+        self.observation_space = spaces.Box(features.low, features.high, dtype=np.float32)
+        self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
+        self._sign = 1.0 if self.role == "pursuer" else -1.0
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Start a game; ``seed`` is the game's master seed (later seedless resets draw
+        theirs from it); never seeded, seeds are random."""
+        super().reset(seed=check_seed(seed))
+        obs = self.episode.reset(episode_seed(seed, self.np_random))
+        return obs[self.role], {"seed": self.episode.seed}
+
+    def step(self, action):
+        """One decision period (ValueError for a bad action)."""
+        obs, reward, done = self.episode.step({self.role: action})
+        return obs[self.role], self._sign * reward, False, done, self.episode.info()
+
+    def close(self) -> None:
+        self.episode.close()
+
+
+class PursuitEnv(_SingleAgentEnv):
+    """``pegame/Pursuit-v0``: the learner is the pursuer."""
+
+    role = "pursuer"
+
+
+class EvasionEnv(_SingleAgentEnv):
+    """``pegame/Evasion-v0``: the learner is the evader."""
+
+    role = "evader"
+
+
+def register_envs() -> None:
+    """Register ``pegame/Pursuit-v0`` and ``pegame/Evasion-v0`` with Gymnasium (idempotent;
+    importing :mod:`pegame.envs` does it)."""
+    for env_id, cls in ((PURSUIT_ID, PursuitEnv), (EVASION_ID, EvasionEnv)):
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point=f"{cls.__module__}:{cls.__name__}")

@@ -1,0 +1,286 @@
+"""pegame.envs: the ecosystem's own API checkers, seeding, actions and observations."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pegame.api import Pose
+from pegame.config import compose
+from pegame.envs.crop import LocalCrop, local_crop_reference
+from pegame.errors import ConfigError
+from pegame.maps import OccupancyGrid
+
+gymnasium = pytest.importorskip("gymnasium")
+pettingzoo_test = pytest.importorskip("pettingzoo.test")
+
+import pegame.envs  # noqa: E402  (registers the Gymnasium ids)
+from pegame.envs import parallel_env  # noqa: E402
+
+#: 3 s games on the smallest paper map keep every test short
+SHORT = ["env=enclosed", "game.t_max=3"]
+IDS = ["pegame/Pursuit-v0", "pegame/Evasion-v0"]
+
+
+@pytest.fixture(scope="module")
+def par_env():
+    env = parallel_env(overrides=SHORT, crop_cells=8)
+    yield env
+    env.close()
+
+
+def rollout(env, seed: int, action_seed: int = 0) -> list:
+    """(observations, rewards, poses) of every step of one seeded game with random actions."""
+    rng = np.random.default_rng(action_seed)
+    obs, _ = env.reset(seed=seed)
+    match = env.episode.match
+    steps = [(obs, None, (match.pursuer, match.evader))]
+    while env.agents:
+        actions = {agent: rng.uniform(-1, 1, 2).astype(np.float32) for agent in env.agents}
+        obs, rewards, _, _, _ = env.step(actions)
+        steps.append((obs, rewards, (match.pursuer, match.evader)))
+    return steps
+
+
+def same(a: list, b: list) -> bool:
+    return len(a) == len(b) and all(
+        pa == pb and ra == rb and all(np.array_equal(oa[k], ob[k]) for k in oa)
+        for (oa, ra, pa), (ob, rb, pb) in zip(a, b)
+    )
+
+
+# ----------------------------------------------------------------- ecosystem checkers
+
+
+def test_pettingzoo_parallel_api(par_env):
+    pettingzoo_test.parallel_api_test(par_env, num_cycles=50)
+
+
+def test_pettingzoo_parallel_seed():
+    pettingzoo_test.parallel_seed_test(lambda: parallel_env(overrides=SHORT, crop_cells=8), num_cycles=10)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_gymnasium_check_env(env_id):
+    from gymnasium.utils.env_checker import check_env
+
+    env = gymnasium.make(env_id, overrides=[*SHORT, "game.t_max=1"], crop_cells=8, opponent="random")
+    check_env(env.unwrapped, skip_render_check=True)
+    env.close()
+
+
+def test_importing_registers_both_ids():
+    assert set(IDS) <= set(gymnasium.registry)
+    pegame.envs.register_envs()  # idempotent
+    env = gymnasium.make("pegame.envs:pegame/Pursuit-v0", overrides=SHORT, crop_cells=4)
+    assert env.observation_space.shape == (8 + 16,)
+
+
+# --------------------------------------------------------------------------- seeding
+
+
+def test_same_seed_same_trajectories_and_no_state_leaks(par_env):
+    first = rollout(par_env, seed=7)
+    rollout(par_env, seed=8)  # another game in between must not change the next one
+    assert same(first, rollout(par_env, seed=7))
+    assert not same(first, rollout(par_env, seed=9))
+    fresh = parallel_env(overrides=SHORT, crop_cells=8)
+    assert same(first, rollout(fresh, seed=7))
+
+
+def test_seedless_resets_follow_the_last_seed(par_env):
+    par_env.reset(seed=3)
+    _, info_a = par_env.reset()
+    par_env.reset(seed=3)
+    _, info_b = par_env.reset()
+    assert info_a["pursuer"]["seed"] == info_b["pursuer"]["seed"] != 3
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, "0"])
+def test_bad_seed_is_a_value_error(par_env, seed):
+    with pytest.raises(ValueError, match="seed"):
+        par_env.reset(seed=seed)
+
+
+# --------------------------------------------------------------------------- actions
+
+
+@pytest.mark.parametrize(
+    "action, message",
+    [
+        (np.array([np.nan, 0.0], np.float32), "finite"),
+        (np.array([0.5, 0.2, 0.1], np.float32), "shape"),
+        (np.array([1.5, 0.0], np.float32), r"\[-1, 1\]"),
+        ("fast", "2 numbers"),
+    ],
+)
+def test_bad_actions_raise_and_leave_the_game_untouched(par_env, action, message):
+    par_env.reset(seed=0)
+    match = par_env.episode.match
+    before = (match.step, match.pursuer, match.evader)
+    with pytest.raises(ValueError, match=message):
+        par_env.step({"pursuer": np.zeros(2, np.float32), "evader": action})
+    assert (match.step, match.pursuer, match.evader) == before
+
+
+def test_missing_or_unknown_agents_raise(par_env):
+    par_env.reset(seed=0)
+    with pytest.raises(ValueError, match="missing"):
+        par_env.step({"pursuer": np.zeros(2, np.float32)})
+    with pytest.raises(ValueError, match="unexpected"):
+        par_env.step({"pursuer": np.zeros(2), "evader": np.zeros(2), "referee": np.zeros(2)})
+
+
+def test_clip_actions_clips_finite_values_only():
+    env = parallel_env(overrides=SHORT, crop_cells=4, clip_actions=True)
+    clipped = rollout_with(env, np.array([3.0, -7.0], np.float32))
+    exact = rollout_with(parallel_env(overrides=SHORT, crop_cells=4), np.array([1.0, -1.0], np.float32))
+    assert clipped == exact
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="finite"):
+        env.step({"pursuer": np.array([np.inf, 0.0]), "evader": np.zeros(2)})
+
+
+def rollout_with(env, action: np.ndarray) -> list[tuple[Pose, Pose]]:
+    env.reset(seed=1)
+    poses = []
+    while env.agents:
+        env.step({"pursuer": action, "evader": action})
+        poses.append((env.episode.match.pursuer, env.episode.match.evader))
+    return poses
+
+
+def test_step_before_reset_raises():
+    env = parallel_env(overrides=SHORT, crop_cells=4)
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step({"pursuer": np.zeros(2), "evader": np.zeros(2)})
+
+
+# ------------------------------------------------------------ rewards, infos, periods
+
+
+def test_zero_sum_rewards_count_detections_and_info_ends_with_the_metrics(par_env):
+    steps = rollout(par_env, seed=2)
+    rewards = [r for _, r, _ in steps[1:]]
+    assert all(r["pursuer"] == -r["evader"] in (0.0, 1.0) for r in rewards)
+    assert len(rewards) == 30  # 3 s at 10 Hz, one control tick per step
+    match = par_env.episode.match
+    summary = match.metrics.summary()
+    info = par_env.episode.info()
+    assert info["metrics"] == summary and info["tracking_rate"] == pytest.approx(summary["tracking_rate"])
+    # Rewards count detections at ticks 1..30, the measure ticks 0..29.
+    first = match.metrics.detected[0]
+    assert sum(r["pursuer"] for r in rewards) == 30 * summary["tracking_rate"] - first + (match.detection is not None)
+
+
+def test_decision_period_holds_each_action_for_whole_ticks():
+    env = parallel_env(overrides=SHORT, crop_cells=4, decision_period=0.4)
+    rewards = [r for _, r, _ in rollout(env, seed=0)[1:]]
+    assert len(rewards) == 8  # 30 ticks in steps of 4, the last one shorter
+    assert all(0 <= r["pursuer"] <= 4 for r in rewards)
+    with pytest.raises(ConfigError, match="decision_period"):
+        parallel_env(overrides=SHORT, decision_period=0.15)
+
+
+def test_single_agent_envs_play_against_the_chosen_opponent():
+    env = gymnasium.make("pegame/Evasion-v0", overrides=SHORT, opponent="random", crop_cells=4)
+    assert env.unwrapped.opponent == "random"
+    obs, info = env.reset(seed=0)
+    total = 0.0
+    truncated = False
+    while not truncated:
+        obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        assert not terminated and reward <= 0.0
+        total += reward
+    assert "metrics" in info and obs in env.observation_space
+    default = gymnasium.make("pegame/Pursuit-v0", overrides=SHORT, crop_cells=4)
+    assert default.unwrapped.opponent == "smart"
+
+
+def test_config_and_opponent_must_agree():
+    cfg = compose([*SHORT, "evader=random"])
+    env = gymnasium.make("pegame/Pursuit-v0", config=cfg, crop_cells=4)
+    assert env.unwrapped.opponent == "random"
+    with pytest.raises(ConfigError, match="opponent"):
+        gymnasium.make("pegame/Pursuit-v0", config=cfg, opponent="smart")
+    with pytest.raises(ConfigError, match="not both"):
+        gymnasium.make("pegame/Pursuit-v0", config=cfg, overrides=SHORT)
+
+
+def test_belief_summary_is_optional_and_runs_the_estimator():
+    env = parallel_env(overrides=SHORT, crop_cells=4, belief=True)
+    obs, _ = env.reset(seed=0)
+    layout = env.layouts["pursuer"]
+    assert layout["belief"] == slice(8, 12) and obs["pursuer"].shape == (12 + 16,)
+    assert obs["pursuer"][8] == 1.0  # the particle filter starts on the first detection
+    assert "belief" not in parallel_env(overrides=SHORT, crop_cells=4).layouts["pursuer"]
+
+
+# ------------------------------------------------------------------------ observations
+
+
+def test_observations_lie_in_their_space_and_start_with_a_detection(par_env):
+    obs, _ = par_env.reset(seed=4)
+    for agent, vector in obs.items():
+        assert vector.dtype == np.float32 and vector in par_env.observation_space(agent)
+    p = obs["pursuer"]
+    assert p[4] == 1.0 and 0.0 < p[5] <= 1.0 and p[7] == 0.0  # seen now, in range, age 0
+    layout = par_env.layouts["evader"]
+    assert set(layout) == {"pose", "pursuer", "relative", "crop"} and layout["crop"].stop == obs["evader"].size
+
+
+def test_pose_features_are_normalised_by_the_map_extent(par_env):
+    par_env.reset(seed=4)
+    match = par_env.episode.match
+    p = par_env.episode.observations()["pursuer"]
+    x0, x1, y0, y1 = match.context.grid.extent
+    pose = match.pursuer
+    assert p[0] == pytest.approx(2 * (pose.x - x0) / (x1 - x0) - 1, abs=1e-6)
+    assert p[1] == pytest.approx(2 * (pose.y - y0) / (y1 - y0) - 1, abs=1e-6)
+    assert p[2:4] == pytest.approx([math.cos(pose.theta), math.sin(pose.theta)], abs=1e-6)
+
+
+def _room(yaw: float = 0.0) -> OccupancyGrid:
+    """A 4 m x 3 m room at 0.05 m/cell with a one-cell-thin wall at x = 2 m."""
+    data = np.zeros((60, 80), dtype=np.int8)
+    data[:, 40] = 100
+    data[30:35, 10:15] = -1
+    return OccupancyGrid(data, 0.05, (0.3, -0.2, yaw))
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.4])
+def test_crop_kernel_matches_the_reference(yaw):
+    grid = _room(yaw)
+    rng = np.random.default_rng(0)
+    for cells, resolution in [(8, 0.5), (32, 0.2), (5, 0.05)]:
+        crop = LocalCrop(grid, cells, resolution)
+        for x, y, theta in rng.uniform([-1, -1, -4], [5, 4, 4], (20, 3)):
+            expected = local_crop_reference(grid, x, y, theta, cells, resolution)
+            assert np.array_equal(crop(x, y, theta).reshape(cells, cells), expected)
+
+
+def test_crop_is_egocentric_and_sees_thin_walls():
+    grid = _room()  # the thin wall spans x in [2.3, 2.35] m
+    # 0.35 m before the wall's near edge, facing it: the wall is ahead (+x, the columns).
+    ahead = local_crop_reference(grid, 1.95, 1.2, 0.0, 4, 0.4)
+    assert ahead[:, 2].all() and not ahead[:, :2].any()
+    # Facing +y the same wall is on the robot's right (-y, the low rows).
+    left = local_crop_reference(grid, 1.95, 1.2, math.pi / 2, 4, 0.4)
+    assert left[1, :].all() and not left[2:, :].any()
+    # Off the map is blocked: near the lower-left corner, facing -x.
+    behind = local_crop_reference(grid, 0.35, 1.2, math.pi, 4, 0.5)
+    assert behind[:, 2:].all()
+
+
+def test_bench_reports_steps_per_second():
+    figures = pegame.envs.bench_steps_per_second(seconds=0.2, overrides=SHORT)
+    assert figures["steps_per_s"] > 0 and figures["reset_ms"] > 0
+
+
+def test_unknown_options_suggest_the_closest():
+    with pytest.raises(ConfigError, match="Did you mean 'crop_cells'"):
+        parallel_env(overrides=SHORT, crop_cell=8)
+    with pytest.raises(ConfigError, match="'crop_resolution'"):
+        parallel_env(overrides=SHORT, crop_resolution=0.0)
