@@ -139,6 +139,12 @@ class RerunRecorder(Recorder):
         self._rec = None
         self._flush_every = config.live_flush_every if config.spawn else config.flush_every
         self._rows: list[tuple] = []
+        self._outlines: list[np.ndarray] = []  # one (2 outline_rays + 1, 3) polygon per row
+        # particles: per tick with any, (step, time), the (k, 2) positions and uint8 shades
+        self._particle_ticks: list[tuple[int, float]] = []
+        self._particle_xy: list[np.ndarray] = []
+        self._particle_shade: list[np.ndarray] = []
+        self._has_particles = False
         self._buffers: dict[str, _Buffer] = {}
         self._trails = {name: _Trail(Z_TRAIL) for name in ("pursuer", "evader")}
         self._plans: list = [None, None]
@@ -203,13 +209,13 @@ class RerunRecorder(Recorder):
 
         rec, ctx = self._rec, self.context
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-        rec.log("world/map", grid_map(ctx.grid), static=True)
+        rec.log("world/map", _cached_grid_map(ctx.grid), static=True)
         w, h = ctx.camera.image_width, ctx.camera.image_height
         border = [[(0, 0), (w, 0), (w, h), (0, h), (0, 0)]]
         rec.log("camera/frame", rr.LineStrips2D(border, colors=[(128, 128, 128)]), static=True)
         text = f"```yaml\n{yaml.safe_dump(properties, sort_keys=False)}```\n"
         rec.log("config", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
-        for path, style in _styles(ctx.pursuer.radius, ctx.evader.radius).items():
+        for path, style in _styles(float(ctx.pursuer.radius), float(ctx.evader.radius)).items():
             rec.log(path, style, static=True)
 
     def _finish(self, result: dict[str, Any]) -> None:
@@ -248,8 +254,6 @@ class RerunRecorder(Recorder):
     def _log(self, tick: Tick) -> None:
         """Buffer the tick: its numbers as one row (sent by :meth:`_send_rows`), its
         variable-size data (trajectories, outline, particles, plans, events) in buffers."""
-        import rerun as rr
-
         if self._last is None:
             has_image = tick.frame.rgb is not None
             self._rec.send_blueprint(blueprint(self.context.grid, self.context.camera, has_image))
@@ -259,9 +263,8 @@ class RerunRecorder(Recorder):
         if tick.step % self.config.trail_every == 0:
             self._log_trails(tick)
         ctx = self.context
-        outline = visibility_outline(tick.visible, ctx.grid, tick.pursuer, ctx.camera, self.config.outline_rays,
-                                     Z_REGION)
-        self._add("world/pursuer/visible", rr.LineStrips3D, tick, strips=[outline])
+        self._outlines.append(visibility_outline(tick.visible, ctx.grid, tick.pursuer, ctx.camera,
+                                                 self.config.outline_rays, Z_REGION))
         self._log_particles(tick)
         self._log_plans(tick)
         self._log_events(tick)
@@ -285,28 +288,25 @@ class RerunRecorder(Recorder):
         if buffer is None:
             if not create:
                 return
-            prepare = particle_columns if path == "world/belief/particles" else None
-            buffer = self._buffers[path] = _Buffer(path, kind, prepare)
+            buffer = self._buffers[path] = _Buffer(path, kind)
         buffer.add(tick.step, tick.time, **values)
 
     def _log_particles(self, tick: Tick) -> None:
-        """A strided subsample of the particles with their shade (weight / the largest)."""
-        import rerun as rr
-
+        """A strided subsample of the particles and of their weights (none: NaN, shaded 0.5)."""
         particles, weights = tick.belief.particles, tick.belief.weights
         if particles is None or self.config.max_particles == 0:
-            if "world/belief/particles" not in self._buffers:
+            if not self._has_particles:
                 return
-            particles = np.zeros((0, 3))
-        stride = max(1, math.ceil(len(particles) / max(1, self.config.max_particles)))
-        xy = particles[::stride, :2].copy()
-        if weights is None or len(xy) == 0:
-            shade = np.full(len(xy), 0.5)
+            xy, shade = _NO_XY, _NO_SHADE  # an empty row clears the particles shown
         else:
-            picked = weights[::stride]
-            top = picked.max()
-            shade = picked / top if top > 0 else np.zeros(len(xy))
-        self._add("world/belief/particles", rr.Points3D, tick, xy=xy, shade=shade)
+            self._has_particles = True
+            stride = -(-len(particles) // self.config.max_particles) or 1
+            xy = particles[::stride, :2].copy()
+            # the weights as they are: shaded per tick when sent (see _send_particles)
+            shade = np.full(len(xy), np.nan) if weights is None else weights[::stride].copy()
+        self._particle_ticks.append((tick.step, tick.time))
+        self._particle_xy.append(xy)
+        self._particle_shade.append(shade)
 
     def _log_plans(self, tick: Tick) -> None:
         """Paths, goals and candidates, only when a strategy has made a new plan."""
@@ -377,8 +377,46 @@ class RerunRecorder(Recorder):
             columns = dict(zip(ROW, np.array(self._rows, dtype=float).T))
             self._rows = []
             self._send_rows(columns, indexes)
+        self._send_outlines(indexes)
+        self._send_particles(indexes)
         for buffer in self._buffers.values():
             buffer.send(self._rec, indexes)
+
+    def _send_outlines(self, indexes: dict) -> None:
+        """The visibility outlines, one per row (the rows' index, cached by :meth:`_send_rows`)."""
+        import rerun as rr
+
+        if not self._outlines:
+            return
+        outlines, self._outlines = np.stack(self._outlines), []
+        every = indexes[self._rows_key]
+        self._send("world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips_array(outlines)))
+
+    def _send_particles(self, indexes: dict) -> None:
+        """The buffered particle subsamples, one row per tick, coloured by their shade."""
+        import rerun as rr
+
+        if not self._particle_ticks:
+            return
+        ticks, xy, shade = self._particle_ticks, self._particle_xy, self._particle_shade
+        self._particle_ticks, self._particle_xy, self._particle_shade = [], [], []
+        sizes = np.fromiter((len(part) for part in xy), dtype=np.int64, count=len(xy))
+        weights = np.concatenate(shade).astype(float)
+        # shade = weight / the largest weight of its tick, quantised to 0-255
+        starts = np.cumsum(sizes) - sizes
+        filled = sizes > 0
+        top = np.zeros(len(sizes))
+        if filled.any():
+            top[filled] = np.maximum.reduceat(weights, starts[filled])
+        top = np.repeat(top, sizes)
+        scale = np.divide(255.0, top, out=np.zeros_like(top), where=top > 0)
+        shade = np.clip(np.nan_to_num(weights * scale) + 0.5, 0, 255).astype(np.uint8)
+        shade[np.isnan(weights)] = 128
+        columns = particle_columns(np.concatenate(xy), shade)
+        steps = np.fromiter((step for step, _ in ticks), dtype=np.int64, count=len(ticks))
+        times = np.fromiter((time for _, time in ticks), dtype=float, count=len(ticks))
+        self._send("world/belief/particles", _index(indexes, steps, times),
+                   rr.Points3D.columns(**columns).partition(sizes))
 
     def _send(self, path: str, index: list, columns) -> None:
         self._rec.send_columns(path, indexes=index, columns=columns, strict=True)
@@ -387,6 +425,7 @@ class RerunRecorder(Recorder):
         """Send the buffered rows (columns ``c``, named as in :data:`ROW`), vectorised."""
         steps, times = c["step"].astype(np.int64), c["time"]
         every = _index(indexes, steps, times)
+        self._rows_key = steps.tobytes()
         self._send_agents(c, every)
         self._send_sensing(c, every)
         self._send_plots(c, every, lambda given: _index(indexes, steps[given], times[given]))
@@ -449,6 +488,7 @@ ROW = (
     "mean_x", "mean_y", "n_eff", "rate",
 )
 _NO_DETECTION = (math.nan,) * 8
+_NO_XY, _NO_SHADE = np.zeros((0, 2)), np.zeros(0, dtype=np.uint8)
 
 
 def _row(tick: Tick, rate: float) -> tuple:
@@ -655,10 +695,30 @@ def visibility_outline(mask: np.ndarray, grid, pose: Pose, camera, rays: int, z:
 
 
 def particle_columns(xy: np.ndarray, shade: np.ndarray) -> dict[str, np.ndarray]:
-    """Points3D columns of particles: (M, 2) map-frame positions (m) and their shade in
-    [0, 1] (weight / the tick's largest weight) -> positions and colours."""
-    colors = LIGHT_PARTICLE + shade[:, None] * (HEAVY_PARTICLE - LIGHT_PARTICLE)
-    return {"positions": _xyz(xy, Z_PARTICLES), "colors": colors.astype(np.uint8)}
+    """Points3D columns of particles: (M, 2) map-frame positions (m) and their shade
+    (uint8, 255 * weight / the tick's largest weight) -> positions and packed RGBA colours."""
+    return {"positions": _xyz(xy, Z_PARTICLES), "colors": _particle_palette()[shade]}
+
+
+@lru_cache(maxsize=1)
+def _particle_palette() -> np.ndarray:
+    """The 256 particle colours (0xRRGGBBAA), from LIGHT_PARTICLE (shade 0) to HEAVY_PARTICLE (255)."""
+    t = np.arange(256)[:, None] / 255.0
+    rgba = np.round(LIGHT_PARTICLE + t * (HEAVY_PARTICLE - LIGHT_PARTICLE)).astype(np.uint32)
+    return (rgba[:, 0] << 24) | (rgba[:, 1] << 16) | (rgba[:, 2] << 8) | rgba[:, 3]
+
+
+_GRID_MAPS: dict[int, tuple[Any, Any]] = {}
+
+
+def _cached_grid_map(grid):
+    """:func:`grid_map` of ``grid``, kept for the next games of the process on the same grid
+    (the map is static; building its payload is the larger part of starting a recording)."""
+    hit = _GRID_MAPS.get(id(grid))
+    if hit is None or hit[0] is not grid:
+        _GRID_MAPS.clear()
+        hit = _GRID_MAPS[id(grid)] = (grid, grid_map(grid))
+    return hit[1]
 
 
 def grid_map(grid):
@@ -683,6 +743,7 @@ def grid_map(grid):
     )
 
 
+@lru_cache(maxsize=4)
 def _styles(pursuer_radius: float, evader_radius: float) -> dict[str, Any]:
     """Static colours and sizes (m) of every entity, logged once."""
     import rerun as rr
