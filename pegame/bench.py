@@ -201,6 +201,7 @@ def recorder_cost(games: int, out_dir: str) -> tuple[float | None, float | None]
     if not all("smart" in registry.available(g) for g in ("pursuer", "evader")):
         return None, None
     base = ["pursuer=smart", "evader=smart", "env=enclosed"]
+    games_per_second([*base, "recorder=rerun"], 1, out_dir)  # imports rerun-sdk, compiles the outline kernel
     plain = 1.0 / games_per_second([*base, "recorder=none"], games, out_dir)
     recorded = 1.0 / games_per_second([*base, "recorder=rerun"], games, out_dir)
     sizes = [p.stat().st_size for p in Path(out_dir).glob("*.rrd")]
