@@ -118,8 +118,7 @@ def describe(group: str) -> list[tuple[str, str, str]]:
     rows = []
     for name, point in _entry_points(group).items():
         try:
-            text = (load(group, name).description or "").strip().splitlines()[0:1]
-            text = text[0] if text else ""
+            text = next(iter((load(group, name).description or "").strip().splitlines()), "")
         except (PluginError, TypeError) as exc:
             text = f"(broken: {exc})"
         rows.append((name, distribution_of(point), text))
