@@ -27,6 +27,7 @@ import numpy as np
 from pegame.errors import require
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
+    from pegame.geometry import VisibilityRegion
     from pegame.maps import OccupancyGrid
 
 
@@ -201,15 +202,16 @@ class PursuerObservation:
     """What the pursuer strategy is given at each tick.
 
     time (s); pose: its own true pose (the paper assumes a localised robot); detection of
-    the evader this tick, or None; belief: the estimator's current belief; visible: bool
-    mask (height, width) over the grid of the pursuer's own visibility region this tick.
+    the evader this tick, or None; belief: the estimator's current belief; visible: the
+    pursuer's own visibility region this tick (``visible.mask`` is a bool (H, W) mask over
+    the grid, computed when first read).
     """
 
     time: float
     pose: Pose
     detection: Detection | None
     belief: Belief
-    visible: np.ndarray
+    visible: VisibilityRegion
 
 
 @dataclass(frozen=True)
@@ -253,7 +255,7 @@ class Tick:
     """Everything that happened at one control tick, as the recorder receives it.
 
     step: control tick index; time (s); pursuer, evader: true poses; frame: the sensor
-    frame; detection or None; belief; visible: the pursuer's visibility mask (H, W);
+    frame; detection or None; belief; visible: the pursuer's visibility region;
     in_view: ground-truth visibility of the evader; commands: (pursuer, evader) velocities
     applied after this tick; plans: the latest (pursuer, evader) plans.
     """
@@ -265,7 +267,7 @@ class Tick:
     frame: SensorFrame
     detection: Detection | None
     belief: Belief
-    visible: np.ndarray
+    visible: VisibilityRegion
     in_view: bool
     commands: tuple[Velocity, Velocity]
     plans: tuple[Plan, Plan]
@@ -337,15 +339,16 @@ class Estimator(Plugin):
     """
 
     @abstractmethod
-    def reset(self, pursuer: Pose, detection: Detection | None, visible: np.ndarray) -> Belief:
+    def reset(self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion) -> Belief:
         """Start a new game; the evader is in view at the start (the paper's protocol)."""
 
     @abstractmethod
     def update(
-        self, dt: float, pursuer: Pose, detection: Detection | None, visible: np.ndarray
+        self, dt: float, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
     ) -> Belief:
         """Predict dt seconds (s) ahead and correct with this tick's detection (or its
-        absence) and the pursuer's visibility mask (bool (H, W) over the grid)."""
+        absence) and the pursuer's visibility region (``visible.mask`` is a bool (H, W) mask
+        over the grid; ``visible.mask_over`` computes only a block of it)."""
 
 
 class Strategy(Plugin):

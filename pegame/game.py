@@ -38,7 +38,7 @@ from pegame.api import (
 from pegame.config import EnvConfig, GameConfig, resolve_map_path, typed
 from pegame.errors import SpawnError
 from pegame.files import write_atomic
-from pegame.geometry import in_view, visibility_region
+from pegame.geometry import VisibilityRegion, in_view, visibility_region
 from pegame.maps import OccupancyGrid, load_map
 from pegame.metrics import TrackingMetrics
 from pegame.navigation import Planner
@@ -174,7 +174,7 @@ class Game:
                 p_pose, e_pose = sim.poses
                 frame = sim.sense(time)
                 detection = detector.detect(frame)
-                visible = visibility_region(grid, p_pose, camera)
+                visible = VisibilityRegion(grid, p_pose, camera)
                 if step == 0:
                     belief = estimator.reset(p_pose, detection, visible)
                 else:

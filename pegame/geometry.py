@@ -222,6 +222,118 @@ def visibility_region(grid: OccupancyGrid, pose: Pose, camera: Camera) -> np.nda
     return mask
 
 
+class VisibilityRegion:
+    """The visibility region V^p_k of the camera at one pose, computed on demand.
+
+    :attr:`mask` is the whole region of :func:`visibility_region`, computed once. Most
+    consumers need only part of it: the particle filter asks about its particles' cells,
+    which usually lie in a small block of the grid. :meth:`mask_over` marches only the
+    rays that can reach a given block of cells, and only as far as the block. On the block
+    this gives exactly the cells of the whole mask: the same rays are sampled at the same
+    points and stop at the same blocked sample, and no other sample can land in the block.
+    """
+
+    def __init__(self, grid: OccupancyGrid, pose: Pose, camera: Camera) -> None:
+        self.grid, self.pose, self.camera = grid, pose, camera
+        self._mask: np.ndarray | None = None
+
+    @classmethod
+    def given(cls, mask: np.ndarray) -> VisibilityRegion:
+        """A region known by its bool (H, W) mask, for sensors that see otherwise and for
+        tests; :meth:`mask_over` returns the mask itself."""
+        region = cls.__new__(cls)
+        region.grid = region.pose = region.camera = None
+        region._mask = np.asarray(mask, dtype=bool)
+        return region
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """(H, W) of the mask."""
+        return self.grid.blocked.shape if self._mask is None else self._mask.shape
+
+    @property
+    def mask(self) -> np.ndarray:
+        """The whole region: bool (H, W) over the grid, read-only."""
+        if self._mask is None:
+            self._mask = visibility_region(self.grid, self.pose, self.camera)
+            self._mask.setflags(write=False)
+        return self._mask
+
+    def mask_over(self, rows: tuple[int, int], cols: tuple[int, int]) -> np.ndarray:
+        """A bool (H, W) mask equal to :attr:`mask` on the cells with rows[0] <= row <=
+        rows[1] and cols[0] <= col <= cols[1], and False or equal to it elsewhere."""
+        if self._mask is not None:
+            return self._mask
+        grid, pose, camera = self.grid, self.pose, self.camera
+        angles, distances, first = _ray_tables(camera)
+        i0, i1, samples = _rays_reaching(
+            angles, camera.angle_step, camera.distance_step, distances.size,
+            float(pose.x), float(pose.y), float(pose.theta), *grid.origin, float(grid.resolution),
+            rows[0], rows[1], cols[0], cols[1],
+        )
+        mask = np.zeros(grid.blocked.shape, dtype=bool)
+        if i1 > i0 and samples > first:
+            towards = pose.theta + angles[i0:i1]
+            _march(grid.blocked, np.cos(towards), np.sin(towards), distances[:samples], first,
+                   float(pose.x), float(pose.y), grid_frame(grid), mask)
+        return mask
+
+
+#: cells; how far :func:`_rays_reaching` grows a block to absorb rounding at cell edges
+_REACH_MARGIN = 0.5
+
+
+@njit(cache=True, inline="always")
+def _wrapped(angle):
+    """``angle`` (rad) wrapped to [-pi, pi)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True)
+def _rays_reaching(angles, angle_step, distance_step, n_distances, px, py, theta, ox, oy, yaw,
+                   resolution, row0, row1, col0, col1):
+    """(first ray, stop ray, samples): the camera's rays angles[first:stop] (rad from the
+    heading theta) and the number of samples along each (from the first) that can land in
+    the block of cells row0..row1 x col0..col1 (inclusive), seen from (px, py) (map frame,
+    m). The block is grown by _REACH_MARGIN cells, and one ray and one sample more are
+    taken on every side, so rounding at cell edges cannot hide a sample.
+    """
+    # Cell coordinates: u along columns, v along rows, in cells from the grid origin.
+    du, dv = (px - ox) / resolution, (py - oy) / resolution
+    u = math.cos(yaw) * du + math.sin(yaw) * dv
+    v = -math.sin(yaw) * du + math.cos(yaw) * dv
+    us = (col0 - _REACH_MARGIN - u, col1 + 1 + _REACH_MARGIN - u)
+    vs = (row0 - _REACH_MARGIN - v, row1 + 1 + _REACH_MARGIN - v)
+    reach = 0.0
+    for a in us:
+        for b in vs:
+            reach = max(reach, math.hypot(a, b))
+    samples = min(n_distances, math.ceil(reach * resolution / distance_step) + 2)
+    if us[0] <= 0.0 <= us[1] and vs[0] <= 0.0 <= vs[1]:
+        return 0, angles.size, samples
+    # The camera is outside the convex block, so the bearings of its corners span less
+    # than pi about the bearing of its centre.
+    centre = math.atan2(vs[0] + vs[1], us[0] + us[1])
+    low, high = math.inf, -math.inf
+    for a in us:
+        for b in vs:
+            offset = _wrapped(math.atan2(b, a) - centre)
+            low, high = min(low, offset), max(high, offset)
+    heading = _wrapped(centre + yaw - theta)
+    first, last = angles.size, -1
+    for turn in (-1.0, 0.0, 1.0):
+        lo = heading + low + turn * 2.0 * math.pi
+        hi = heading + high + turn * 2.0 * math.pi
+        if hi < angles[0] - angle_step or lo > angles[-1] + angle_step:
+            continue  # this turn of the bearings misses the field of view
+        i0 = np.searchsorted(angles, lo, side="left") - 1
+        i1 = np.searchsorted(angles, hi, side="right")
+        first, last = min(first, max(i0, 0)), max(last, min(i1, angles.size - 1))
+    if last < first:
+        return 0, 0, samples
+    return first, last + 1, samples
+
+
 # --------------------------------------------------------------------- line of sight
 
 

@@ -23,7 +23,7 @@ world/pursuer/heading      Arrows3D                                     every ti
 world/pursuer/trajectory   LineStrips3D, positions so far, one every ``trail_every``
                            ticks; logged at those ticks and at the last one
 world/pursuer/fov          LineStrips3D, ``geometry.fov_wedge``         every tick
-world/pursuer/visible      LineStrips3D, outline of the visibility mask every tick
+world/pursuer/visible      LineStrips3D, outline of the visibility region every tick
 world/pursuer/path, goal   the current plan's path and goal            new plans
 world/evader/...           pose, heading, trajectory, path and goal (the chosen
                            escape point), as the pursuer's
@@ -118,7 +118,7 @@ class RerunRecorder(Recorder):
         live_flush_every: int = 10  # the same with spawn=true, so that the live viewer keeps up
         max_particles: int = 300  # particles logged per tick, an evenly strided subsample (0: none)
         trail_every: int = 5  # control ticks between trajectory points (and re-logs of the trajectories)
-        outline_rays: int = 64  # rays marched on the visibility mask to draw its outline
+        outline_rays: int = 64  # rays cast on the grid to draw the visibility region's outline
         image_every: int = 10  # control ticks between logged camera images (0: none)
         jpeg_quality: int = 80  # JPEG quality (1-100) of the logged camera images
 
@@ -140,6 +140,7 @@ class RerunRecorder(Recorder):
         self._flush_every = config.live_flush_every if config.spawn else config.flush_every
         self._rows: list[tuple] = []
         self._outlines: list[np.ndarray] = []  # one (2 outline_rays + 1, 3) polygon per row
+        self._free = np.ascontiguousarray(context.grid.free)  # cells the outline's rays cross
         # particles: per tick with any, (step, time), the (k, 2) positions and uint8 shades
         self._particle_ticks: list[tuple[int, float]] = []
         self._particle_xy: list[np.ndarray] = []
@@ -263,8 +264,8 @@ class RerunRecorder(Recorder):
         if tick.step % self.config.trail_every == 0:
             self._log_trails(tick)
         ctx = self.context
-        self._outlines.append(visibility_outline(tick.visible, ctx.grid, tick.pursuer, ctx.camera,
-                                                 self.config.outline_rays, Z_REGION))
+        self._outlines.append(visibility_outline(ctx.grid, tick.pursuer, ctx.camera,
+                                                 self.config.outline_rays, Z_REGION, self._free))
         self._log_particles(tick)
         self._log_plans(tick)
         self._log_events(tick)
@@ -630,32 +631,32 @@ def fov_template(camera) -> np.ndarray:
     return fov_wedge(camera, Pose(0.0, 0.0, 0.0), n=16)
 
 
-def _outline(mask, x, y, theta, ox, oy, yaw, slices, near, far, resolution, z):
-    """Closed (2 n + 1, 3) float32 polygon around the visibility mask; n = slices.size.
+def _outline(free, x, y, theta, ox, oy, yaw, slices, near, far, resolution, z):
+    """Closed (2 n + 1, 3) float32 polygon around the visibility region; n = slices.size.
 
     Plain Python reference of the compiled kernel (:func:`_outline_kernel`); see
     :func:`visibility_outline`. Rays leave (x, y) (map frame, m) at theta + slices[i]
-    (rad) and are marched in the grid frame, in cells, one cell at a time.
+    (rad) and are marched in the grid frame, in cells, one cell at a time, over ``free``.
     """
-    height, width = mask.shape
+    height, width = free.shape
     n = slices.size
     out = np.empty((2 * n + 1, 3), dtype=np.float32)
     c, s = math.cos(yaw), math.sin(yaw)
     u = (c * (x - ox) + s * (y - oy)) / resolution
     v = (-s * (x - ox) + c * (y - oy)) / resolution
-    # Cells that straddle the near range are only partly seen: start one cell beyond it.
+    # Cells that straddle the near range are only partly seen: reach starts one cell beyond it.
     start = near / resolution + 1.0
-    count = max(0, math.ceil(far / resolution - start))
+    count = math.floor(far / resolution) + 1
     for i in range(n):
         du, dv = math.cos(theta - yaw + slices[i]), math.sin(theta - yaw + slices[i])
         reach = near
-        for j in range(count):
-            d = start + j
+        for d in range(count):
             fc, fr = u + d * du, v + d * dv
             # Range checks on the floats, so that int() (truncation) equals floor.
-            if fr < 0.0 or fr >= height or fc < 0.0 or fc >= width or not mask[int(fr), int(fc)]:
+            if fr < 0.0 or fr >= height or fc < 0.0 or fc >= width or not free[int(fr), int(fc)]:
                 break
-            reach = d * resolution
+            if d >= start:
+                reach = d * resolution
         cw, sw = math.cos(theta + slices[i]), math.sin(theta + slices[i])
         out[i, 0], out[i, 1], out[i, 2] = x + reach * cw, y + reach * sw, z
         k = 2 * n - 1 - i
@@ -678,19 +679,22 @@ def _slices(fov: float, rays: int) -> np.ndarray:
     return fov * ((np.arange(rays) + 0.5) / rays - 0.5)
 
 
-def visibility_outline(mask: np.ndarray, grid, pose: Pose, camera, rays: int, z: float = 0.0,
-                       compiled: bool = True) -> np.ndarray:
+def visibility_outline(grid, pose: Pose, camera, rays: int, z: float = 0.0,
+                       free: np.ndarray | None = None, compiled: bool = True) -> np.ndarray:
     """Closed (2 rays + 1, 3) float32 polygon (map frame, m, at height z) around the
-    pursuer's visibility mask (bool (H, W) over ``grid``).
+    visibility region of the camera at ``pose`` on ``grid``.
 
-    ``rays`` rays at the centres of equal slices of the FOV are marched over the mask
-    from the near range on, one cell at a time, up to the first cell that is not visible;
-    the polygon runs along the far ends of the rays, then back along the near arc.
-    compiled=False runs the plain Python reference.
+    ``rays`` rays at the centres of equal slices of the FOV are cast from the camera one
+    cell at a time up to the first blocked cell (``free``: the grid's free cells, given
+    to save recomputing them) or the far range; the polygon runs along their far ends
+    from the near range on, then back along the near arc. It draws the region that
+    :func:`pegame.geometry.visibility_region` computes, at ``rays`` angles instead of
+    every ``camera.angle_step``. compiled=False runs the plain Python reference.
     """
     ox, oy, yaw = grid.origin
     march = _outline_kernel() if compiled else _outline
-    return march(mask, float(pose.x), float(pose.y), float(pose.theta), ox, oy, yaw,
+    free = grid.free if free is None else free
+    return march(free, float(pose.x), float(pose.y), float(pose.theta), ox, oy, yaw,
                  _slices(camera.fov, rays), camera.near, camera.far, float(grid.resolution), z)
 
 

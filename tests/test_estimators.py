@@ -15,6 +15,7 @@ import yaml
 from pegame import registry
 from pegame.api import Body, BoundingBox, Camera, Context, Detection, Pose
 from pegame.errors import ConfigError
+from pegame.geometry import VisibilityRegion
 from pegame.estimators.kalman import KalmanEstimator
 from pegame.estimators.last_seen import LastSeen
 from pegame.estimators.particle_filter import (
@@ -68,10 +69,10 @@ def detection(x, y):
 
 
 def disc(grid, center, radius):
-    """Bool (H, W) mask of the cells whose centre lies within ``radius`` m of ``center``."""
+    """The region of the cells whose centre lies within ``radius`` m of ``center``."""
     rows, cols = np.mgrid[0 : grid.height, 0 : grid.width]
     x, y = grid.cell_to_world(rows, cols)
-    return (x - center[0]) ** 2 + (y - center[1]) ** 2 <= radius**2
+    return VisibilityRegion.given((x - center[0]) ** 2 + (y - center[1]) ** 2 <= radius**2)
 
 
 def cell_values(grid, particles, mask):
@@ -144,7 +145,7 @@ def test_weights_stay_normalised_over_a_long_run():
         # The target walks at up to 0.4 m/s inside the free part left of the block.
         target = np.clip(target + rng.uniform(-0.04, 0.04, 2), [0.3, 0.3], [2.7, 3.7])
         view = disc(grid, rng.uniform([0.5, 0.5], [4.5, 3.5]), 1.2)
-        seen = bool(cell_values(grid, target[None, :], view)[0])
+        seen = bool(cell_values(grid, target[None, :], view.mask)[0])
         found = detection(*(target + rng.normal(0.0, 0.1, 2))) if seen else None
         belief = pf.update(DT, PURSUER, found, view)
         w = belief.weights
@@ -174,9 +175,9 @@ def test_negative_information_moves_mass_out_of_the_seen_region():
     pf = build(ParticleFilter, grid, seed=5, rho=0.0, init_spread=0.5)
     start = pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 2.0))
     view = disc(grid, (2.0, 2.0), 0.5)  # covers the cloud's right part
-    before = start.weights[cell_values(grid, start.particles, view)].sum()
+    before = start.weights[cell_values(grid, start.particles, view.mask)].sum()
     after = pf.update(0.0, PURSUER, None, view)  # dt 0: only the measurement acts
-    inside = cell_values(grid, after.particles, view)
+    inside = cell_values(grid, after.particles, view.mask)
     mass = after.weights[inside].sum()
     assert 0.1 < before < 0.9
     expected = 0.05 * before / (0.05 * before + (1.0 - before))  # miss_factor 0.05
@@ -192,11 +193,11 @@ def reference_weights(grid, cfg, particles, prior, found, view):
         if not grid.contains(row, col) or grid.blocked[row, col]:
             weights.append(0.0)
         elif found is None:
-            weights.append(w * (cfg.miss_factor if view[row, col] else 1.0))
+            weights.append(w * (cfg.miss_factor if view.mask[row, col] else 1.0))
         else:
             zx, zy = found.position
             likelihood = math.exp(-((x - zx) ** 2 + (y - zy) ** 2) / (2 * cfg.sigma**2))
-            weights.append(w * likelihood * (cfg.seen_boost if view[row, col] else 1.0))
+            weights.append(w * likelihood * (cfg.seen_boost if view.mask[row, col] else 1.0))
     return np.array(weights) / sum(weights)
 
 
@@ -308,7 +309,10 @@ def test_systematic_round_off_edge_case(monkeypatch):
 
 def run_side_by_side(grid, steps, seed, **params):
     """Feed one random run of views and detections (some far off, so the track is lost)
-    to a filter's update and to a twin's update_reference; yield both beliefs per step."""
+    to a filter's update and to a twin's update_reference; yield both beliefs per step.
+
+    Every other view is a camera's visibility region at a random pose, which the fast
+    path asks only about its particles' block of cells and the reference as a whole."""
     fast = build(ParticleFilter, grid, seed=seed, **params)
     slow = build(ParticleFilter, grid, seed=seed, **params)
     rng = np.random.default_rng(seed + 1)
@@ -318,11 +322,15 @@ def run_side_by_side(grid, steps, seed, **params):
     yield fast.reset(PURSUER, start, view), slow.reset(PURSUER, start, view)
     for step in range(steps):
         view = disc(grid, rng.uniform([x0, y0], [x1, y1]), rng.uniform(0.5, 2.0))
+        fast_view = slow_view = view
+        if step % 2:
+            camera = Pose(*rng.uniform([x0, y0, -math.pi], [x1, y1, math.pi]))
+            fast_view, slow_view = (VisibilityRegion(grid, camera, Camera()) for _ in range(2))
         found = None
         if step % 3:
             far = step % 29 == 0
             found = detection(*rng.uniform([x0, y0], [x1, y1]) if far else rng.normal(start.position, 0.3))
-        yield fast.update(DT, PURSUER, found, view), slow.update_reference(DT, PURSUER, found, view)
+        yield fast.update(DT, PURSUER, found, fast_view), slow.update_reference(DT, PURSUER, found, slow_view)
     assert fast.rng.bit_generator.state == slow.rng.bit_generator.state
 
 
@@ -395,8 +403,8 @@ def test_vanished_weights_reinitialise_outside_the_view(caplog):
     assert np.all(np.isfinite(belief.particles)) and np.all(np.isfinite(belief.mean))
     assert np.all(belief.weights == 1.0 / 2000)
     assert np.all(on_free(grid, belief.particles))
-    assert not np.any(cell_values(grid, belief.particles, view))
-    everywhere = np.ones((grid.height, grid.width), dtype=bool)  # nothing left unseen
+    assert not np.any(cell_values(grid, belief.particles, view.mask))
+    everywhere = VisibilityRegion.given(np.ones((grid.height, grid.width), dtype=bool))  # nothing left unseen
     pf.reset(PURSUER, detection(1.5, 2.0), everywhere)
     belief = pf.update(DT, PURSUER, None, everywhere)
     assert np.all(on_free(grid, belief.particles)) and np.all(np.isfinite(belief.weights))
@@ -446,8 +454,8 @@ def test_reset_without_detection_covers_the_visible_free_cells():
     pf = build(ParticleFilter, grid, seed=20)
     view = disc(grid, (3.0, 2.0), 1.0)  # straddles the block
     belief = pf.reset(PURSUER, None, view)
-    assert np.all(cell_values(grid, belief.particles, view & grid.free))
-    nothing = np.zeros((grid.height, grid.width), dtype=bool)
+    assert np.all(cell_values(grid, belief.particles, view.mask & grid.free))
+    nothing = VisibilityRegion.given(np.zeros((grid.height, grid.width), dtype=bool))
     belief = pf.reset(PURSUER, None, nothing)
     assert np.all(on_free(grid, belief.particles))
     assert np.ptp(belief.particles[:, 0]) > 3.5  # spread over the whole room
@@ -476,7 +484,7 @@ def test_visibility_mask_of_the_wrong_shape_is_rejected():
     grid = room()
     pf = build(ParticleFilter, grid, n_particles=10)
     with pytest.raises(ValueError, match="shape"):
-        pf.reset(PURSUER, None, np.ones((3, 3), dtype=bool))
+        pf.reset(PURSUER, None, VisibilityRegion.given(np.ones((3, 3), dtype=bool)))
 
 
 # --------------------------------------------------------------------------- kalman

@@ -10,6 +10,7 @@ from scipy.ndimage import binary_dilation
 
 from pegame.api import Camera, Pose
 from pegame.geometry import (
+    VisibilityRegion,
     _line_of_sight_reference,
     _ray_tables,
     fov_wedge,
@@ -154,6 +155,41 @@ def test_fast_mask_equals_reference_with_samples_on_cell_edges(yaw):
         pose = Pose(x, y, yaw + float(rng.choice([0.0, 0.5, 1.0, -0.5])) * math.pi)
         fast = visibility_region(grid, pose, camera)
         assert np.array_equal(fast, visibility_region_reference(grid, pose, camera))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_region_over_a_block_equals_the_whole_mask_there(seed):
+    # Random grids (rotated origins too), cameras (up to a full turn of FOV), poses on and
+    # off the grid, and blocks of cells small and large, inside, across the edge and off it.
+    rng = np.random.default_rng(300 + seed)
+    height, width = rng.integers(20, 70, 2)
+    resolution = float(rng.choice([0.05, 0.1]))
+    yaw = 0.0 if seed % 2 else float(rng.uniform(-math.pi, math.pi))
+    grid = random_grid(rng, height, width, resolution, (rng.uniform(-3, 3), rng.uniform(-3, 3), yaw))
+    partial = 0
+    for _ in range(60):
+        camera, pose = random_camera(rng), random_free_pose(rng, grid)
+        whole = visibility_region(grid, pose, camera)
+        top, left = rng.integers(-5, [height, width])
+        bottom, right = top + rng.integers(0, 15), left + rng.integers(0, 15)
+        over = VisibilityRegion(grid, pose, camera).mask_over((top, bottom), (left, right))
+        block = np.s_[max(top, 0) : max(bottom + 1, 0), max(left, 0) : max(right + 1, 0)]
+        assert np.array_equal(over[block], whole[block])
+        assert not np.any(over & ~whole)
+        partial += over.sum() < whole.sum()
+    assert partial > 20  # most blocks needed only part of the region
+
+
+def test_region_mask_is_computed_once_and_read_only():
+    grid = random_grid(np.random.default_rng(5), 40, 40, 0.1)
+    region = VisibilityRegion(grid, Pose(2.0, 2.0, 0.3), CAMERA)
+    assert region.shape == (40, 40)
+    mask = region.mask
+    assert region.mask is mask and not mask.flags.writeable
+    assert np.array_equal(mask, visibility_region(grid, Pose(2.0, 2.0, 0.3), CAMERA))
+    assert region.mask_over((0, 0), (0, 0)) is mask  # once whole, always whole
+    given = VisibilityRegion.given(np.eye(3, dtype=bool))
+    assert given.shape == (3, 3) and given.mask_over((0, 0), (0, 0)) is given.mask
 
 
 @pytest.mark.parametrize("region", BOTH)

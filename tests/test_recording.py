@@ -33,7 +33,7 @@ from pegame.api import (
 )
 from pegame.figures import plot_trajectory
 from pegame.game import Game
-from pegame.geometry import visibility_region
+from pegame.geometry import VisibilityRegion, visibility_region
 from pegame.maps import OccupancyGrid
 from pegame.recording import RerunRecorder, recording_id, visibility_outline
 from pegame.replay import find_recordings, main as replay_main, viewer_command
@@ -158,7 +158,7 @@ def synthetic_ticks(context: Context, count: int) -> list[Tick]:
                 Plan(goal=(4.0, 5.0), path=np.array([[3.5, 4.0], [4.0, 5.0]]),
                      info={"candidates": np.array([[4.0, 5.0], [5.0, 3.0], [2.0 + decision, 6.0]])}),
             )
-        visible = visibility_region(context.grid, pursuer, context.camera)
+        visible = VisibilityRegion(context.grid, pursuer, context.camera)
         ticks.append(Tick(step, 0.1 * step, pursuer, evader, SensorFrame(0.1 * step, pursuer), detection,
                           belief, visible, detection is not None, (Velocity(), Velocity()), plans[decision]))
     return ticks
@@ -239,13 +239,13 @@ def test_recording_id_is_deterministic_per_place_and_config(tmp_path):
     assert recording_id(tmp_path, "game", config) != recording_id(tmp_path, "game", {"game": {"seed": 4}})
 
 
-def test_visibility_outline_matches_its_reference_and_bounds_the_mask():
+def test_visibility_outline_matches_its_reference_and_bounds_the_region():
     context = small_context()
     grid, camera = context.grid, context.camera
     for pose in (Pose(1.0, 4.5, 0.2), Pose(3.0, 5.0, -2.5), Pose(4.5, 4.0, 0.1)):
         mask = visibility_region(grid, pose, camera)
-        fast = visibility_outline(mask, grid, pose, camera, 64, z=0.01)
-        slow = visibility_outline(mask, grid, pose, camera, 64, z=0.01, compiled=False)
+        fast = visibility_outline(grid, pose, camera, 64, z=0.01)
+        slow = visibility_outline(grid, pose, camera, 64, z=0.01, compiled=False)
         np.testing.assert_array_equal(fast, slow)
         assert fast.shape == (129, 3) and np.array_equal(fast[0], fast[-1])
         reach = np.hypot(fast[:64, 0] - pose.x, fast[:64, 1] - pose.y)

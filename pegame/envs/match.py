@@ -28,7 +28,7 @@ from omegaconf import DictConfig
 
 from pegame.api import EMPTY_BELIEF, Belief, EvaderObservation, PursuerObservation, Velocity
 from pegame.game import STREAMS, Game, spawn
-from pegame.geometry import in_view, visibility_region
+from pegame.geometry import VisibilityRegion, in_view
 from pegame.metrics import TrackingMetrics
 
 ROLES = ("pursuer", "evader")
@@ -87,10 +87,10 @@ class Match:
         self.pursuer, self.evader = plugins["sim"].poses
         p = self.pursuer
         self.detection = plugins["detector"].detect(plugins["sim"].sense(self.time))
-        self.visible: np.ndarray | None = None
+        self.visible: VisibilityRegion | None = None
         self.belief: Belief = EMPTY_BELIEF
         if self.estimating:
-            self.visible = visibility_region(grid, p, camera)
+            self.visible = VisibilityRegion(grid, p, camera)
             estimator = plugins["estimator"]
             if self.step == 0:
                 self.belief = estimator.reset(p, self.detection, self.visible)

@@ -34,6 +34,7 @@ from filterpy.kalman import KalmanFilter
 
 from pegame.api import EMPTY_BELIEF, Belief, Detection, Estimator, Pose
 from pegame.errors import require
+from pegame.geometry import VisibilityRegion
 
 
 class KalmanEstimator(Estimator):
@@ -55,7 +56,7 @@ class KalmanEstimator(Estimator):
         super().__init__(config, context, rng)
         self._kf: KalmanFilter | None = None
 
-    def reset(self, pursuer: Pose, detection: Detection | None, visible: np.ndarray) -> Belief:
+    def reset(self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion) -> Belief:
         """Forget the track; start one at ``detection`` if there is one."""
         self._kf = None
         if detection is not None:
@@ -63,7 +64,7 @@ class KalmanEstimator(Estimator):
         return self._belief()
 
     def update(
-        self, dt: float, pursuer: Pose, detection: Detection | None, visible: np.ndarray
+        self, dt: float, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
     ) -> Belief:
         """Predict ``dt`` s ahead, then correct with the detection's map position if any."""
         if self._kf is None:

@@ -4,8 +4,8 @@ and "Smart Pursuer").
 Sequential Importance Sampling (SIS) over the evader state (x m, y m, theta rad) in the map
 frame (x right, y up, theta from +x, counter-clockwise, in (-pi, pi]). The filter is given
 the map (``context.grid``), the evader's max speed (``context.evader.v_max``, m/s) and, at
-every control tick, the pursuer's detection (or None) and visibility region V_k^p (a bool
-mask over the grid); never the true evader pose.
+every control tick, the pursuer's detection (or None) and visibility region V_k^p (a
+:class:`pegame.geometry.VisibilityRegion`); never the true evader pose.
 
 - Motion model, the paper's unicycle u = [V cos(phi), V sin(phi), omega]: every particle
   draws a speed V ~ U[0, v_max] (m/s) and a turn rate omega ~ N(0, turn_rate_std^2) (rad/s)
@@ -37,12 +37,14 @@ issue #290). The tests compare these against filterpy's.
 
 Fast path. :meth:`ParticleFilter.update` runs the per-particle arithmetic (unicycle
 motion, cell lookup, blocked and visible tests, weighting) and the covariance in numba
-kernels, and inverts the cumulative weights for resampling in numba. The motion draws
-happen inside the kernel, on the component's Generator through numba's ports of numpy's
-samplers: the same numbers in the same order as the plain numpy reference
-:meth:`ParticleFilter.update_reference`, which the fast path matches bit for bit in
-particles, weights, N_eff and mean (the covariance to round-off); the tests hold it to
-that. Three steps stay numpy calls on purpose, because the numba equivalents round
+kernels, and inverts the cumulative weights for resampling in numba. It asks V_k^p only
+about the block of cells its moved particles landed in (``VisibilityRegion.mask_over``),
+so the camera's rays are cast only towards them, with the same answer there as the whole
+mask. The motion draws happen inside the kernel, on the component's Generator through
+numba's ports of numpy's samplers: the same numbers in the same order as the plain numpy
+reference :meth:`ParticleFilter.update_reference`, which the fast path matches bit for
+bit in particles, weights, N_eff and mean (the covariance to round-off); the tests hold
+it to that. Three steps stay numpy calls on purpose, because the numba equivalents round
 differently: ``np.exp`` (numpy's SIMD exp differs from libm's in the last bit), and the
 sums and dot products behind the normalisation, N_eff and the mean (numpy's pairwise
 sums and BLAS).
@@ -61,6 +63,7 @@ from scipy.ndimage import distance_transform_edt
 
 from pegame.api import Belief, Detection, Estimator, Pose
 from pegame.errors import MapError, require
+from pegame.geometry import VisibilityRegion
 
 log = logging.getLogger(__name__)
 
@@ -69,11 +72,6 @@ RESAMPLERS = ("systematic", "stratified", "residual", "multinomial")
 LOST_GATE = 5.0
 #: redraws of initial particles that land in blocked cells before snapping them to free ones
 RESEED_TRIES = 5
-
-# Where a moved particle lies, per particle, as the kernels classify it.
-_BLOCKED = 0  # in a blocked cell or off the grid
-_UNSEEN = 1  # in a free cell outside the visibility region
-_SEEN = 2  # in a free cell inside the visibility region
 
 
 def wrap(angles: np.ndarray) -> np.ndarray:
@@ -206,9 +204,10 @@ def _wrap_angle(angle):
 
 
 @njit(cache=True)
-def _move_and_place(particles, rng, v_max, turn_rate_std, dt, frame, blocked, visible):
-    """The particles (N, 3) moved by the unicycle model, and where each lands (N,)
-    (_BLOCKED, _UNSEEN or _SEEN).
+def _move_and_locate(particles, rng, v_max, turn_rate_std, dt, frame, blocked):
+    """The particles (N, 3) moved by the unicycle model, the flat cell index (N,) each
+    lands in (-1 in a blocked cell or off the grid), and the (row min, row max, col min,
+    col max) of those cells ((0, -1, 0, -1) when all are blocked).
 
     Same draws from ``rng`` as :meth:`ParticleFilter._draw` (numba's Generator runs
     numpy's algorithms on the same bit generator), and :meth:`ParticleFilter._predict`
@@ -222,27 +221,36 @@ def _move_and_place(particles, rng, v_max, turn_rate_std, dt, frame, blocked, vi
     speed = rng.uniform(0.0, v_max, n)
     normal = rng.standard_normal(n)
     moved = np.empty((n, 3))
-    place = np.empty(n, dtype=np.int8)
-    ox, oy, rotate, c, s, res = frame
-    height, width = blocked.shape
     for i in range(n):
         turn = turn_rate_std * normal[i]
         heading = particles[i, 2] + 0.5 * turn * dt
         step = speed[i] * dt
-        x = particles[i, 0] + step * math.cos(heading)
-        y = particles[i, 1] + step * math.sin(heading)
-        moved[i, 0], moved[i, 1] = x, y
-        moved[i, 2] = _wrap_angle(particles[i, 2] + turn * dt)
-        dx, dy = x - ox, y - oy
+        moved[i, 0] = particles[i, 0] + step * math.cos(heading)
+        moved[i, 1] = particles[i, 1] + step * math.sin(heading)
+        moved[i, 2] = particles[i, 2] + turn * dt
+    # Separate passes: the motion above runs without branches, and so faster.
+    for i in range(n):
+        moved[i, 2] = _wrap_angle(moved[i, 2])
+    cells = np.empty(n, dtype=np.int64)
+    ox, oy, rotate, c, s, res = frame
+    height, width = blocked.shape
+    row_min, row_max, col_min, col_max = height, -1, width, -1
+    for i in range(n):
+        dx, dy = moved[i, 0] - ox, moved[i, 1] - oy
         if rotate:
             dx, dy = c * dx + s * dy, -s * dx + c * dy
         # floor stays a float until the range check: no integer overflow off the grid.
         row, col = np.floor(dy / res), np.floor(dx / res)
         if not (0.0 <= row < height and 0.0 <= col < width) or blocked[int(row), int(col)]:
-            place[i] = _BLOCKED
+            cells[i] = -1
         else:
-            place[i] = _SEEN if visible[int(row), int(col)] else _UNSEEN
-    return moved, place
+            r, k = int(row), int(col)
+            cells[i] = r * width + k
+            row_min, row_max = min(row_min, r), max(row_max, r)
+            col_min, col_max = min(col_min, k), max(col_max, k)
+    if row_max < 0:
+        row_min = col_min = 0
+    return moved, cells, (row_min, row_max, col_min, col_max)
 
 
 @njit(cache=True)
@@ -256,28 +264,30 @@ def _exponents(moved, zx, zy, two_sigma2):
 
 
 @njit(cache=True)
-def _weigh_miss(prior, place, miss_factor):
-    """Weights (N,) after a miss: prior * miss_factor inside V, prior outside, 0 blocked."""
+def _weigh_miss(prior, cells, visible, miss_factor):
+    """Weights (N,) after a miss: prior * miss_factor inside V, prior outside, 0 blocked.
+
+    cells: flat cell index per particle (-1 blocked); visible: flat bool mask of V."""
     weights = np.empty(prior.size)
     for i in range(prior.size):
-        if place[i] == _BLOCKED:
+        if cells[i] < 0:
             weights[i] = 0.0
         else:
-            weights[i] = prior[i] * (miss_factor if place[i] == _SEEN else 1.0)
+            weights[i] = prior[i] * (miss_factor if visible[cells[i]] else 1.0)
     return weights
 
 
 @njit(cache=True)
-def _weigh_hit(prior, place, likelihood, seen_boost):
+def _weigh_hit(prior, cells, visible, likelihood, seen_boost):
     """Weights (N,) after a detection: prior * (likelihood * seen_boost inside V, the
     likelihood outside), 0 on blocked cells, where ``likelihood`` is also set to 0."""
     weights = np.empty(prior.size)
     for i in range(prior.size):
-        if place[i] == _BLOCKED:
+        if cells[i] < 0:
             likelihood[i] = 0.0
             weights[i] = 0.0
         else:
-            weights[i] = prior[i] * (likelihood[i] * (seen_boost if place[i] == _SEEN else 1.0))
+            weights[i] = prior[i] * (likelihood[i] * (seen_boost if visible[cells[i]] else 1.0))
     return weights
 
 
@@ -340,7 +350,7 @@ class ParticleFilter(Estimator):
 
     # ------------------------------------------------------------------ interface
 
-    def reset(self, pursuer: Pose, detection: Detection | None, visible: np.ndarray) -> Belief:
+    def reset(self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion) -> Belief:
         """Draw the initial particles: around the detection if any (N(z, init_spread) on
         free cells), else uniformly over the free cells inside ``visible`` (or over all
         free cells when none is visible); headings uniform, weights 1/N."""
@@ -352,17 +362,17 @@ class ParticleFilter(Estimator):
                 )
             self.particles = self._around(detection.position)
         else:
-            inside = self._free_cells[self._flat_mask(visible)[self._free_cells]]
+            inside = self._free_cells[self._flat_mask(visible.mask)[self._free_cells]]
             self.particles = self._uniform(inside if inside.size else self._free_cells)
         n = self.config.n_particles
         self.weights = np.full(n, 1.0 / n)
         return self._belief(float(n), resampled=False)
 
     def update(
-        self, dt: float, pursuer: Pose, detection: Detection | None, visible: np.ndarray
+        self, dt: float, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
     ) -> Belief:
         """Predict ``dt`` s with the unicycle model, weigh by the detection (or its absence)
-        and ``visible`` (bool (H, W) over the grid), resample when N_eff < rho * N.
+        and the pursuer's visibility region, resample when N_eff < rho * N.
 
         The belief's ``n_eff`` is N_eff of the normalised weights before any resampling
         (the value compared with rho * N), or 0 when the particle set was lost and redrawn.
@@ -370,17 +380,17 @@ class ParticleFilter(Estimator):
         return self._update(dt, detection, visible, reference=False)
 
     def update_reference(
-        self, dt: float, pursuer: Pose, detection: Detection | None, visible: np.ndarray
+        self, dt: float, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
     ) -> Belief:
         """:meth:`update` in plain numpy: the reference the tests hold the kernels to."""
         return self._update(dt, detection, visible, reference=True)
 
     def _update(
-        self, dt: float, detection: Detection | None, visible: np.ndarray, reference: bool
+        self, dt: float, detection: Detection | None, visible: VisibilityRegion, reference: bool
     ) -> Belief:
         """:meth:`update`, or with ``reference`` :meth:`update_reference`."""
         cfg = self.config
-        self._flat_mask(visible)  # rejects a mask of the wrong shape before any draw
+        self._check_shape(visible.shape)  # before any draw
         weigh = self._weigh_reference if reference else self._weigh
         moved, weights, likelihood = weigh(dt, detection, visible)
         lost = detection is not None and (
@@ -406,15 +416,17 @@ class ParticleFilter(Estimator):
         weights (N,) and, with a detection, its likelihood (N,) (0 on blocked cells;
         else None), by the kernels."""
         cfg = self.config
-        moved, place = _move_and_place(
+        moved, cells, (r0, r1, c0, c1) = _move_and_locate(
             self.particles, self.rng, self.context.evader.v_max, cfg.turn_rate_std, dt,
-            self._frame, self.context.grid.blocked, visible,
+            self._frame, self.context.grid.blocked,
         )
+        # Only the block of cells the particles landed in is asked for (module docstring).
+        seen = self._flat_mask(visible.mask_over((r0, r1), (c0, c1)))
         if detection is None:
-            return moved, _weigh_miss(self.weights, place, cfg.miss_factor), None
+            return moved, _weigh_miss(self.weights, cells, seen, cfg.miss_factor), None
         zx, zy = detection.position
         likelihood = np.exp(_exponents(moved, zx, zy, 2.0 * cfg.sigma**2))
-        weights = _weigh_hit(self.weights, place, likelihood, cfg.seen_boost)
+        weights = _weigh_hit(self.weights, cells, seen, likelihood, cfg.seen_boost)
         return moved, weights, likelihood
 
     def _weigh_reference(self, dt, detection, visible):
@@ -423,7 +435,7 @@ class ParticleFilter(Estimator):
         moved = self._predict(dt, *self._draw())
         flat, on_grid = self._cells(moved[:, 0], moved[:, 1])
         valid = on_grid & ~self._blocked[flat]
-        seen = on_grid & self._flat_mask(visible)[flat]
+        seen = on_grid & self._flat_mask(visible.mask)[flat]
         if detection is None:
             likelihood = None
             factor = np.where(seen, cfg.miss_factor, 1.0)
@@ -460,7 +472,7 @@ class ParticleFilter(Estimator):
 
     # ------------------------------------------------------------------ sampling
 
-    def _reinitialise(self, detection: Detection | None, visible: np.ndarray) -> Belief:
+    def _reinitialise(self, detection: Detection | None, visible: VisibilityRegion) -> Belief:
         """Redraw the lost particle set: around the detection, or uniformly over the free
         cells outside ``visible`` (all free cells when every one is visible)."""
         if detection is not None:
@@ -474,7 +486,7 @@ class ParticleFilter(Estimator):
                 "Particle filter weights vanished; redrawing the particles uniformly over "
                 "the free cells outside the pursuer's view."
             )
-            hidden = self._free_cells[~self._flat_mask(visible)[self._free_cells]]
+            hidden = self._free_cells[~self._flat_mask(visible.mask)[self._free_cells]]
             self.particles = self._uniform(hidden if hidden.size else self._free_cells)
         n = self.config.n_particles
         self.weights = np.full(n, 1.0 / n)
@@ -525,14 +537,17 @@ class ParticleFilter(Estimator):
         flat, on_grid = self._cells(xy[:, 0], xy[:, 1])
         return on_grid & ~self._blocked[flat]
 
+    def _check_shape(self, shape: tuple[int, ...]) -> None:
+        """Raise ValueError unless a visibility mask of ``shape`` covers the grid."""
+        grid = self.context.grid
+        if shape != (grid.height, grid.width):
+            raise ValueError(
+                f"The visibility mask has shape {shape}; the grid's is {(grid.height, grid.width)}."
+            )
+
     def _flat_mask(self, visible: np.ndarray) -> np.ndarray:
         """The visibility mask (H, W) as a flat bool array, checked against the grid."""
-        grid = self.context.grid
-        if visible.shape != (grid.height, grid.width):
-            raise ValueError(
-                f"The visibility mask has shape {visible.shape}; the grid's is "
-                f"{(grid.height, grid.width)}."
-            )
+        self._check_shape(visible.shape)
         return visible.ravel()
 
     @cached_property
