@@ -6,7 +6,9 @@ pursuer's view; the game lasts ``game.t_max`` seconds. At every control tick (pe
 for the evader, the estimator updates its belief from the detection and the pursuer's
 visibility region; at every decision tick (1 / ``game.decision_hz``) the evader decides
 first, then the pursuer; both then act concurrently at control rate. The pursuer learns
-about the evader only through its detector; the evader is told the pursuer's pose.
+about the evader only through its detector; the evader is told the pursuer's pose. The
+ground truth ``in_view`` of every tick is whether any part of the evader's body is in the
+pursuer's view (:func:`pegame.geometry.body_in_view`).
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ from pegame.api import (
 from pegame.config import EnvConfig, GameConfig, resolve_map_path, typed
 from pegame.errors import SpawnError
 from pegame.files import write_atomic
-from pegame.geometry import VisibilityRegion, in_view, visibility_region
+from pegame.geometry import VisibilityRegion, body_in_view, in_view, visibility_region
 from pegame.maps import OccupancyGrid, load_map
 from pegame.metrics import TrackingMetrics
 from pegame.navigation import Planner
@@ -156,6 +158,7 @@ class Game:
         sim, detector, estimator = self.plugins["sim"], self.plugins["detector"], self.plugins["estimator"]
         pursuer, evader, recorder = self.plugins["pursuer"], self.plugins["evader"], self.plugins["recorder"]
         grid, camera, dt = self.context.grid, self.camera, self.context.control_dt
+        evader_radius = self.context.evader.radius
         ticks = int(round(self.settings.t_max * self.settings.control_hz))
         decide_every = max(1, int(round(self.settings.control_hz / self.settings.decision_hz)))
 
@@ -179,7 +182,7 @@ class Game:
                     belief = estimator.reset(p_pose, detection, visible)
                 else:
                     belief = estimator.update(dt, p_pose, detection, visible)
-                seen = in_view(grid, camera, p_pose, (e_pose.x, e_pose.y))
+                seen = body_in_view(grid, camera, p_pose, (e_pose.x, e_pose.y), evader_radius)
                 e_obs = EvaderObservation(time, e_pose, p_pose)
                 p_obs = PursuerObservation(time, p_pose, detection, belief, visible)
                 if step % decide_every == 0:

@@ -384,6 +384,30 @@ def in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, point_xy) -> bool:
     return line_of_sight(grid, (pose.x, pose.y), (x, y))
 
 
+#: points across a body's silhouette that :func:`body_in_view` tests, in body radii
+SILHOUETTE = (0.0, -1.0, 1.0, -0.5, 0.5)
+
+
+def body_in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, centre_xy, radius: float) -> bool:
+    """True when the camera at ``pose`` sees any part of a body: an upright cylinder of
+    ``radius`` m standing at the map-frame point ``centre_xy`` (m).
+
+    The body's silhouette, seen from the camera, is its diameter across the line of sight;
+    the body is in view when one of the SILHOUETTE points along it (its centre, its two
+    edges, the points halfway) is in view (:func:`in_view`). So a shoulder that shows past
+    a corner or the edge of the field of view counts, as evader pixels in a rendered image
+    would, while the centre is hidden.
+    """
+    x, y = float(centre_xy[0]), float(centre_xy[1])
+    dx, dy = x - pose.x, y - pose.y
+    distance = math.hypot(dx, dy)
+    across = (-dy / distance, dx / distance) if distance > 0.0 else (0.0, 0.0)
+    return any(
+        in_view(grid, camera, pose, (x + k * radius * across[0], y + k * radius * across[1]))
+        for k in SILHOUETTE
+    )
+
+
 def fov_wedge(camera: Camera, pose: Pose, n: int = 32) -> np.ndarray:
     """(K, 2) closed polygon (map frame, m) bounding the camera's field of view at ``pose``.
 

@@ -2,7 +2,9 @@
 
 The tracking rate is the fraction of control ticks at which the pursuer's detector
 reports the evader (paper, Table 1: "tracking success rate"). A *loss* is a maximal run of
-ticks without a detection; it ends in a *reacquisition* when a detection follows.
+ticks without a detection; it ends in a *reacquisition* when a detection follows. The
+visible rate is the fraction of ticks at which any part of the evader's body is in the
+pursuer's view (:func:`pegame.geometry.body_in_view`), the ground truth beside it.
 """
 
 from __future__ import annotations

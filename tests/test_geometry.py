@@ -11,6 +11,7 @@ from scipy.ndimage import binary_dilation
 from pegame.api import Camera, Pose
 from pegame.geometry import (
     VisibilityRegion,
+    body_in_view,
     _line_of_sight_reference,
     _ray_tables,
     fov_wedge,
@@ -347,6 +348,33 @@ def test_in_view_checks_bearing_range_and_occlusion():
     assert not in_view(grid, CAMERA, pose, (1.1, 2.0))  # closer than near
     assert not in_view(grid, CAMERA, pose, (1.0, 3.5))  # outside the fov
     assert not in_view(grid, CAMERA, Pose(0.5, 0.2, 0.0), (3.8, 0.2))  # beyond far
+
+
+def test_body_shows_past_a_wall_edge_or_the_fov_edge_while_its_centre_is_hidden():
+    data = np.full((40, 40), FREE, dtype=np.int8)
+    data[15:25, 30] = OCCUPIED  # a wall at x in [3.0, 3.1) m, y in [1.5, 2.5) m
+    grid = OccupancyGrid(data, 0.1)
+    pose, radius = Pose(1.0, 2.0, 0.0), 0.25
+    behind_edge = (3.5, 2.6)  # centre hidden by the wall's end, one shoulder past it
+    assert not in_view(grid, CAMERA, pose, behind_edge)
+    assert body_in_view(grid, CAMERA, pose, behind_edge, radius)
+    assert not body_in_view(grid, CAMERA, pose, (3.5, 2.0), radius)  # the wall hides it all
+    past_fov = (1.0 + 2.0 * math.cos(0.6), 2.0 + 2.0 * math.sin(0.6))  # 0.076 rad past the edge
+    assert not in_view(grid, CAMERA, pose, past_fov)
+    assert body_in_view(grid, CAMERA, pose, past_fov, radius)
+    assert not body_in_view(grid, CAMERA, pose, past_fov, 0.1)  # a thinner body stays out
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_body_in_view_whenever_its_centre_is(seed):
+    rng = np.random.default_rng(500 + seed)
+    grid = random_grid(rng, 50, 50, 0.1, density=0.1)
+    for _ in range(300):
+        pose, other = random_free_pose(rng, grid), random_free_pose(rng, grid)
+        centre = (other.x, other.y)
+        if in_view(grid, CAMERA, pose, centre):
+            assert body_in_view(grid, CAMERA, pose, centre, 0.2)
+        assert body_in_view(grid, CAMERA, pose, centre, 0.0) == in_view(grid, CAMERA, pose, centre)
 
 
 # -------------------------------------------------------------------------- fov wedge

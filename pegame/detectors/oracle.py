@@ -1,8 +1,10 @@
 """The grid simulator's camera: a geometric detector with a synthetic bounding box.
 
-The evader is detected when it is in view of the pursuer's camera (inside the FOV wedge,
-within [near, far] and in line of sight on the grid, :func:`pegame.geometry.in_view`),
-unless a configured miss happens. The evader is modelled as an upright cylinder (its body
+The evader is detected when its centre is in view of the pursuer's camera (inside the FOV
+wedge, within [near, far] and in line of sight on the grid, :func:`pegame.geometry.in_view`),
+unless a configured miss happens. The game's ground truth is wider: any part of the body
+in view (:func:`pegame.geometry.body_in_view`), so a shoulder past a corner is visible but
+not detected. The evader is modelled as an upright cylinder (its body
 radius, ``evader_height``) projected through a pinhole camera of the configured FOV and
 image size (square pixels) mounted ``camera_height`` above the floor. Depth is the range
 along the optical axis to the evader's axis, optionally with Gaussian noise; the map

@@ -28,7 +28,7 @@ from omegaconf import DictConfig
 
 from pegame.api import EMPTY_BELIEF, Belief, EvaderObservation, PursuerObservation, Velocity
 from pegame.game import STREAMS, Game, spawn
-from pegame.geometry import VisibilityRegion, in_view
+from pegame.geometry import VisibilityRegion, body_in_view
 from pegame.metrics import TrackingMetrics
 
 ROLES = ("pursuer", "evader")
@@ -96,7 +96,8 @@ class Match:
                 self.belief = estimator.reset(p, self.detection, self.visible)
             else:
                 self.belief = estimator.update(self.dt, p, self.detection, self.visible)
-        self.in_view = in_view(grid, camera, p, (self.evader.x, self.evader.y))
+        radius = self.context.evader.radius
+        self.in_view = body_in_view(grid, camera, p, (self.evader.x, self.evader.y), radius)
 
     def pursuer_observation(self) -> PursuerObservation:
         """What a pursuer strategy is given at this tick (needs the visibility region)."""

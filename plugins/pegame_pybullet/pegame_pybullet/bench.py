@@ -2,7 +2,8 @@
 
 - :func:`rtf`: real-time factor of whole games (simulated seconds per second).
 - :func:`visibility_agreement`: how often "evader pixels present" in PyBullet agrees with
-  the grid simulator's geometric visibility (:func:`pegame.geometry.in_view`), and why not.
+  the grid simulator's geometric visibility (:func:`pegame.geometry.body_in_view`), and why
+  not.
 - :func:`memory_growth`: resident memory over many reset/close cycles in one process.
 """
 
@@ -50,8 +51,8 @@ def rtf(env: str = "enclosed", seeds: Iterable[int] = (0,), t_max: float = 90.0,
 
 
 def _why(grid, camera, radius: float, pursuer: Pose, evader: Pose) -> str:
-    """Why pixels of the evader show while its centre is not in view (see
-    :func:`visibility_agreement`)."""
+    """Why pixels of the evader show while its body, as the grid models it, is not in view
+    (see :func:`visibility_agreement`)."""
     dx, dy = evader.x - pursuer.x, evader.y - pursuer.y
     distance = math.hypot(dx, dy)
     if distance <= radius:
@@ -78,14 +79,16 @@ def visibility_agreement(env: str = "enclosed", seeds: Iterable[int] = range(3),
     Each game is played in the grid simulator (``sim=grid detector=oracle``, seeds
     ``seeds``), then every tick's poses are placed in PyBullet and rendered. "Pixels" means
     the segmentation detector finds the evader (at least ``min_pixels`` evader pixels within
-    the camera's range), "in view" means :func:`pegame.geometry.in_view` of the evader's
-    centre. With ``min_visible`` > 0, pixels count only when at least that fraction of the
-    evader's body is visible (:meth:`PybulletSimulator.evader_visible_fraction`, an extra
-    render per tick). Returns the fraction of ticks where both agree, the tick count, and the
-    disagreements by cause: pixels without the centre in view because part of the body
-    reaches past the field of view's edge (``fov_edge``), the range limits
-    (``range_edge``) or an occluder's edge (``occlusion_edge``), or else ``other``; and
-    ``missed``, the centre in view without evader pixels.
+    the camera's range), "in view" is the game's ground truth,
+    :func:`pegame.geometry.body_in_view` of the evader's body (a cylinder of its radius).
+    With ``min_visible`` > 0, pixels count only when at least that fraction of the evader's
+    body is visible (:meth:`PybulletSimulator.evader_visible_fraction`, an extra render per
+    tick). Returns the fraction of ticks where both agree, the tick count, and the
+    disagreements by cause: pixels while the body is out of view, with the 3D person
+    reaching past the cylinder near the field of view's edge (``fov_edge``), the range
+    limits (``range_edge``) or an occluder's edge (``occlusion_edge``), or else ``other``;
+    and ``missed``, the body in view without evader pixels (a sliver of the body below
+    ``min_pixels``, or hidden by the camera's vertical field of view or near clip).
     """
     agree = ticks = 0
     causes: Counter[str] = Counter()
