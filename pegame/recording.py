@@ -139,8 +139,6 @@ class RerunRecorder(Recorder):
         self._rec = None
         self._flush_every = config.live_flush_every if config.spawn else config.flush_every
         self._rows: list[tuple] = []
-        self._outlines: list[np.ndarray] = []  # one (2 outline_rays + 1, 3) polygon per row
-        self._free = np.ascontiguousarray(context.grid.free)  # cells the outline's rays cross
         # particles: per tick with any, (step, time), the (k, 2) positions and uint8 shades
         self._particle_ticks: list[tuple[int, float]] = []
         self._particle_xy: list[np.ndarray] = []
@@ -263,9 +261,6 @@ class RerunRecorder(Recorder):
         self._rows.append(_row(tick, self._detections / (tick.step + 1)))
         if tick.step % self.config.trail_every == 0:
             self._log_trails(tick)
-        ctx = self.context
-        self._outlines.append(visibility_outline(ctx.grid, tick.pursuer, ctx.camera,
-                                                 self.config.outline_rays, Z_REGION, self._free))
         self._log_particles(tick)
         self._log_plans(tick)
         self._log_events(tick)
@@ -378,20 +373,9 @@ class RerunRecorder(Recorder):
             columns = dict(zip(ROW, np.array(self._rows, dtype=float).T))
             self._rows = []
             self._send_rows(columns, indexes)
-        self._send_outlines(indexes)
         self._send_particles(indexes)
         for buffer in self._buffers.values():
             buffer.send(self._rec, indexes)
-
-    def _send_outlines(self, indexes: dict) -> None:
-        """The visibility outlines, one per row (the rows' index, cached by :meth:`_send_rows`)."""
-        import rerun as rr
-
-        if not self._outlines:
-            return
-        outlines, self._outlines = np.stack(self._outlines), []
-        every = indexes[self._rows_key]
-        self._send("world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips_array(outlines)))
 
     def _send_particles(self, indexes: dict) -> None:
         """The buffered particle subsamples, one row per tick, coloured by their shade."""
@@ -432,7 +416,8 @@ class RerunRecorder(Recorder):
         self._send_plots(c, every, lambda given: _index(indexes, steps[given], times[given]))
 
     def _send_agents(self, c: dict[str, np.ndarray], every: list) -> None:
-        """Both poses with their heading arrows, and the pursuer's FOV wedge."""
+        """Both poses with their heading arrows, and the pursuer's FOV wedge and the
+        outline of its visibility region."""
         import rerun as rr
 
         for name, prefix in (("pursuer", "p"), ("evader", "e")):
@@ -442,8 +427,12 @@ class RerunRecorder(Recorder):
             heading = _stack(length * np.cos(theta), length * np.sin(theta), 0.0)
             self._send(f"world/{name}/pose", every, rr.Points3D.columns(positions=here))
             self._send(f"world/{name}/heading", every, rr.Arrows3D.columns(origins=here, vectors=heading))
-        wedges = _placed(fov_template(self.context.camera), c["px"], c["py"], c["ptheta"], Z_REGION)
+        ctx = self.context
+        wedges = _placed(fov_template(ctx.camera), c["px"], c["py"], c["ptheta"], Z_REGION)
         self._send("world/pursuer/fov", every, rr.LineStrips3D.columns(strips=strips_array(wedges)))
+        outlines = visibility_outlines(ctx.grid, c["px"], c["py"], c["ptheta"], ctx.camera,
+                                       self.config.outline_rays, Z_REGION)
+        self._send("world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips_array(outlines)))
 
     def _send_sensing(self, c: dict[str, np.ndarray], every: list) -> None:
         """Detection (map point and image box) and estimate; an empty row where there is none."""
@@ -631,71 +620,114 @@ def fov_template(camera) -> np.ndarray:
     return fov_wedge(camera, Pose(0.0, 0.0, 0.0), n=16)
 
 
-def _outline(free, x, y, theta, ox, oy, yaw, slices, near, far, resolution, z):
-    """Closed (2 n + 1, 3) float32 polygon around the visibility region; n = slices.size.
+def _outlines(runs, xs, ys, thetas, ox, oy, yaw, slices, near, far, resolution, z, jump):
+    """Closed (2 n + 1, 3) float32 polygons around the visibility regions of the camera at
+    the poses (xs, ys, thetas) (map frame, m and rad), one per pose; n = len(slices[0]).
 
-    Plain Python reference of the compiled kernel (:func:`_outline_kernel`); see
-    :func:`visibility_outline`. Rays leave (x, y) (map frame, m) at theta + slices[i]
-    (rad) and are marched in the grid frame, in cells, one cell at a time, over ``free``.
+    See :func:`visibility_outlines`. Rays leave each pose at theta + a_i, where slices =
+    (cos a_i, sin a_i) (a_i in rad from the optical axis), and are sampled in the grid
+    frame one cell apart, up to the first sample in a blocked cell (``runs`` 0, see
+    :func:`free_runs`) or off the grid. With ``jump`` the samples that ``runs`` shows to be
+    free are skipped, which gives the same result as sampling every cell (the plain
+    reference, jump=False).
     """
-    height, width = free.shape
-    n = slices.size
-    out = np.empty((2 * n + 1, 3), dtype=np.float32)
+    height, width = runs.shape
+    slice_cos, slice_sin = slices
+    n = slice_cos.size
+    out = np.empty((xs.size, 2 * n + 1, 3), dtype=np.float32)
     c, s = math.cos(yaw), math.sin(yaw)
-    u = (c * (x - ox) + s * (y - oy)) / resolution
-    v = (-s * (x - ox) + c * (y - oy)) / resolution
     # Cells that straddle the near range are only partly seen: reach starts one cell beyond it.
     start = near / resolution + 1.0
     count = math.floor(far / resolution) + 1
-    for i in range(n):
-        du, dv = math.cos(theta - yaw + slices[i]), math.sin(theta - yaw + slices[i])
-        reach = near
-        for d in range(count):
-            fc, fr = u + d * du, v + d * dv
-            # Range checks on the floats, so that int() (truncation) equals floor.
-            if fr < 0.0 or fr >= height or fc < 0.0 or fc >= width or not free[int(fr), int(fc)]:
-                break
-            if d >= start:
-                reach = d * resolution
-        cw, sw = math.cos(theta + slices[i]), math.sin(theta + slices[i])
-        out[i, 0], out[i, 1], out[i, 2] = x + reach * cw, y + reach * sw, z
-        k = 2 * n - 1 - i
-        out[k, 0], out[k, 1], out[k, 2] = x + near * cw, y + near * sw, z
-    out[2 * n] = out[0]
+    for p in range(xs.size):
+        x, y, theta = xs[p], ys[p], thetas[p]
+        u = (c * (x - ox) + s * (y - oy)) / resolution
+        v = (-s * (x - ox) + c * (y - oy)) / resolution
+        cg, sg = math.cos(theta - yaw), math.sin(theta - yaw)  # the heading in the grid frame
+        cm, sm = math.cos(theta), math.sin(theta)  # the heading in the map frame
+        for i in range(n):
+            du = cg * slice_cos[i] - sg * slice_sin[i]
+            dv = sg * slice_cos[i] + cg * slice_sin[i]
+            last = -1  # the last free sample
+            d = 0
+            while d < count:
+                fc, fr = u + d * du, v + d * dv
+                # Range checks on the floats, so that int() (truncation) equals floor.
+                if fr < 0.0 or fr >= height or fc < 0.0 or fc >= width:
+                    break
+                run = runs[int(fr), int(fc)]
+                if run == 0:
+                    break
+                last = min(d + (run - 1 if jump else 0), count - 1)
+                d = last + 1
+            reach = last * resolution if last >= start else near
+            cw = cm * slice_cos[i] - sm * slice_sin[i]
+            sw = sm * slice_cos[i] + cm * slice_sin[i]
+            out[p, i, 0], out[p, i, 1], out[p, i, 2] = x + reach * cw, y + reach * sw, z
+            k = 2 * n - 1 - i
+            out[p, k, 0], out[p, k, 1], out[p, k, 2] = x + near * cw, y + near * sw, z
+        out[p, 2 * n] = out[p, 0]
     return out
 
 
 @lru_cache(maxsize=1)
-def _outline_kernel():
-    """:func:`_outline` compiled with numba on first use (numba loads only then)."""
+def _outlines_kernel():
+    """:func:`_outlines` compiled with numba on first use (numba loads only then)."""
     from numba import njit
 
-    return njit(cache=True)(_outline)
+    return njit(cache=True)(_outlines)
+
+
+_RUNS: dict[int, tuple[Any, np.ndarray]] = {}
+
+
+def free_runs(grid) -> np.ndarray:
+    """uint8 (H, W): 0 on blocked cells; on a free cell, how many samples one cell apart
+    along any ray from any point of the cell are sure to be free, this one included.
+
+    If the cell's centre lies D cells from the nearest blocked cell's centre or cell off
+    the grid, every point closer than D - sqrt(2) cells to a point of the cell is free: 1 +
+    floor(D - 1.5) samples (at least 1, at most 255). Small, so it stays in cache. Kept for
+    the next games of the process on the same grid.
+    """
+    hit = _RUNS.get(id(grid))
+    if hit is None or hit[0] is not grid:
+        from scipy.ndimage import distance_transform_edt
+
+        free = np.pad(~grid.blocked, 1, constant_values=False)
+        clearance = distance_transform_edt(free)[1:-1, 1:-1]
+        runs = np.where(grid.blocked, 0, 1 + np.clip(np.floor(clearance - 1.5), 0, 254))
+        _RUNS.clear()
+        hit = _RUNS[id(grid)] = (grid, runs.astype(np.uint8))
+    return hit[1]
 
 
 @lru_cache(maxsize=16)
-def _slices(fov: float, rays: int) -> np.ndarray:
-    """Ray angles (rad) from the optical axis: the centres of ``rays`` equal slices of the FOV."""
-    return fov * ((np.arange(rays) + 0.5) / rays - 0.5)
+def _slices(fov: float, rays: int) -> tuple[np.ndarray, np.ndarray]:
+    """(cos, sin) of the ray angles from the optical axis: the centres of ``rays`` equal
+    slices of the FOV (rad)."""
+    angles = fov * ((np.arange(rays) + 0.5) / rays - 0.5)
+    return np.cos(angles), np.sin(angles)
 
 
-def visibility_outline(grid, pose: Pose, camera, rays: int, z: float = 0.0,
-                       free: np.ndarray | None = None, compiled: bool = True) -> np.ndarray:
-    """Closed (2 rays + 1, 3) float32 polygon (map frame, m, at height z) around the
-    visibility region of the camera at ``pose`` on ``grid``.
+def visibility_outlines(grid, xs: np.ndarray, ys: np.ndarray, thetas: np.ndarray, camera,
+                        rays: int, z: float = 0.0, compiled: bool = True) -> np.ndarray:
+    """(P, 2 rays + 1, 3) float32: closed polygons (map frame, m, at height z) around the
+    visibility regions of the camera at P poses (xs, ys, thetas) (m, m, rad) on ``grid``.
 
     ``rays`` rays at the centres of equal slices of the FOV are cast from the camera one
-    cell at a time up to the first blocked cell (``free``: the grid's free cells, given
-    to save recomputing them) or the far range; the polygon runs along their far ends
-    from the near range on, then back along the near arc. It draws the region that
-    :func:`pegame.geometry.visibility_region` computes, at ``rays`` angles instead of
-    every ``camera.angle_step``. compiled=False runs the plain Python reference.
+    cell at a time up to the first blocked cell or the far range; each polygon runs along
+    their far ends from the near range on, then back along the near arc. It draws the
+    region that :func:`pegame.geometry.visibility_region` computes, at ``rays`` angles
+    instead of every ``camera.angle_step``. The compiled kernel skips the cells that the
+    grid's :func:`free_runs` shows to be free, with the same result as compiled=False, the
+    plain Python reference that samples every cell.
     """
     ox, oy, yaw = grid.origin
-    march = _outline_kernel() if compiled else _outline
-    free = grid.free if free is None else free
-    return march(free, float(pose.x), float(pose.y), float(pose.theta), ox, oy, yaw,
-                 _slices(camera.fov, rays), camera.near, camera.far, float(grid.resolution), z)
+    march = _outlines_kernel() if compiled else _outlines
+    poses = (np.asarray(v, dtype=float).reshape(-1) for v in (xs, ys, thetas))
+    return march(free_runs(grid), *poses, ox, oy, yaw, _slices(camera.fov, rays), camera.near,
+                 camera.far, float(grid.resolution), z, compiled)
 
 
 def particle_columns(xy: np.ndarray, shade: np.ndarray) -> dict[str, np.ndarray]:

@@ -35,7 +35,7 @@ from pegame.figures import plot_trajectory
 from pegame.game import Game
 from pegame.geometry import VisibilityRegion, visibility_region
 from pegame.maps import OccupancyGrid
-from pegame.recording import RerunRecorder, recording_id, visibility_outline
+from pegame.recording import RerunRecorder, recording_id, visibility_outlines
 from pegame.replay import find_recordings, main as replay_main, viewer_command
 
 SHORT = ["game.t_max=5", "env=hall"]
@@ -239,21 +239,32 @@ def test_recording_id_is_deterministic_per_place_and_config(tmp_path):
     assert recording_id(tmp_path, "game", config) != recording_id(tmp_path, "game", {"game": {"seed": 4}})
 
 
-def test_visibility_outline_matches_its_reference_and_bounds_the_region():
-    context = small_context()
-    grid, camera = context.grid, context.camera
-    for pose in (Pose(1.0, 4.5, 0.2), Pose(3.0, 5.0, -2.5), Pose(4.5, 4.0, 0.1)):
-        mask = visibility_region(grid, pose, camera)
-        fast = visibility_outline(grid, pose, camera, 64, z=0.01)
-        slow = visibility_outline(grid, pose, camera, 64, z=0.01, compiled=False)
-        np.testing.assert_array_equal(fast, slow)
-        assert fast.shape == (129, 3) and np.array_equal(fast[0], fast[-1])
-        reach = np.hypot(fast[:64, 0] - pose.x, fast[:64, 1] - pose.y)
+@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-0.7, 1.3, 0.4)])
+def test_visibility_outlines_match_their_reference_and_bound_the_region(origin):
+    # Sparse walls on a large grid, so that the kernel's jumps over free cells are long.
+    rng = np.random.default_rng(8)
+    data = np.zeros((150, 150), dtype=np.int8)
+    data[rng.random(data.shape) < 0.003] = 100
+    data[40:110, 75] = 100
+    grid = OccupancyGrid(data, 0.05, origin)
+    camera = Camera()
+    free = np.argwhere(~grid.blocked)[rng.choice(int((~grid.blocked).sum()), 60)]
+    xs, ys = grid.cell_to_world(free[:, 0], free[:, 1])
+    thetas = rng.uniform(-math.pi, math.pi, 60)
+    fast = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01)
+    slow = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01, compiled=False)
+    np.testing.assert_array_equal(fast, slow)
+    assert fast.shape == (60, 129, 3) and np.array_equal(fast[:, 0], fast[:, -1])
+    in_region = []
+    for outline, x, y, theta in zip(fast, xs, ys, thetas):
+        mask = visibility_region(grid, Pose(x, y, theta), camera)
+        reach = np.hypot(outline[:64, 0] - x, outline[:64, 1] - y)
         assert np.all(reach >= camera.near - 1e-4) and np.all(reach <= camera.far + 1e-4)
-        # the far ends lie in visible cells (float32 rounding may move one across a cell edge)
-        rows, cols = grid.world_to_cell(fast[:64, 0], fast[:64, 1])
+        rows, cols = grid.world_to_cell(outline[:64, 0], outline[:64, 1])
         beyond_near = reach > camera.near + 1e-4
-        assert beyond_near.any() and mask[rows[beyond_near], cols[beyond_near]].mean() > 0.95
+        in_region.extend(mask[rows[beyond_near], cols[beyond_near]])
+    # the far ends lie in visible cells (float32 rounding may move one across a cell edge)
+    assert len(in_region) > 2000 and np.mean(in_region) > 0.95
 
 
 def test_config_file_lists_every_field_with_its_default():
