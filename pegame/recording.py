@@ -116,7 +116,7 @@ class RerunRecorder(Recorder):
         spawn: bool = False  # open a live Rerun viewer (single runs); the .rrd is written either way
         flush_every: int = 300  # control ticks buffered before they are sent (larger chunks are cheaper)
         live_flush_every: int = 10  # the same with spawn=true, so that the live viewer keeps up
-        max_particles: int = 300  # particles logged per tick, an evenly strided subsample (0: none)
+        max_particles: int = 100  # particles logged per tick, an evenly strided subsample (0: none)
         trail_every: int = 5  # control ticks between trajectory points (and re-logs of the trajectories)
         outline_rays: int = 64  # rays cast on the grid to draw the visibility region's outline
         image_every: int = 10  # control ticks between logged camera images (0: none)
@@ -140,10 +140,7 @@ class RerunRecorder(Recorder):
         self._flush_every = config.live_flush_every if config.spawn else config.flush_every
         self._rows: list[tuple] = []
         # particles: per tick with any, (step, time), the (k, 2) positions and uint8 shades
-        self._particle_ticks: list[tuple[int, float]] = []
-        self._particle_xy: list[np.ndarray] = []
-        self._particle_shade: list[np.ndarray] = []
-        self._has_particles = False
+        self._particles = _ParticleRows(self._flush_every, config.max_particles)
         self._buffers: dict[str, _Buffer] = {}
         self._trails = {name: _Trail(Z_TRAIL) for name in ("pursuer", "evader")}
         self._plans: list = [None, None]
@@ -212,7 +209,8 @@ class RerunRecorder(Recorder):
         w, h = ctx.camera.image_width, ctx.camera.image_height
         border = [[(0, 0), (w, 0), (w, h), (0, h), (0, 0)]]
         rec.log("camera/frame", rr.LineStrips2D(border, colors=[(128, 128, 128)]), static=True)
-        text = f"```yaml\n{yaml.safe_dump(properties, sort_keys=False)}```\n"
+        dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's, when there, is faster
+        text = f"```yaml\n{yaml.dump(properties, Dumper=dumper, sort_keys=False)}```\n"
         rec.log("config", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
         for path, style in _styles(float(ctx.pursuer.radius), float(ctx.evader.radius)).items():
             rec.log(path, style, static=True)
@@ -228,8 +226,7 @@ class RerunRecorder(Recorder):
             self._add("events", rr.TextLog, self._last, text=[text], level=["INFO"])
         self._flush()
         _send_property(self._rec, "result", flat_config(result))
-        # Waits for the file writer: a write error (full disk) raises here.
-        self._rec.flush()
+        # Closing the file sink waits for its writer: a write error (full disk) raises here.
         self._rec.disconnect()
         self._rec = None
 
@@ -288,21 +285,9 @@ class RerunRecorder(Recorder):
         buffer.add(tick.step, tick.time, **values)
 
     def _log_particles(self, tick: Tick) -> None:
-        """A strided subsample of the particles and of their weights (none: NaN, shaded 0.5)."""
-        particles, weights = tick.belief.particles, tick.belief.weights
-        if particles is None or self.config.max_particles == 0:
-            if not self._has_particles:
-                return
-            xy, shade = _NO_XY, _NO_SHADE  # an empty row clears the particles shown
-        else:
-            self._has_particles = True
-            stride = -(-len(particles) // self.config.max_particles) or 1
-            xy = particles[::stride, :2].copy()
-            # the weights as they are: shaded per tick when sent (see _send_particles)
-            shade = np.full(len(xy), np.nan) if weights is None else weights[::stride].copy()
-        self._particle_ticks.append((tick.step, tick.time))
-        self._particle_xy.append(xy)
-        self._particle_shade.append(shade)
+        """A strided subsample of the particles and of their weights."""
+        if self.config.max_particles:
+            self._particles.add(tick.step, tick.time, tick.belief.particles, tick.belief.weights)
 
     def _log_plans(self, tick: Tick) -> None:
         """Paths, goals and candidates, only when a strategy has made a new plan."""
@@ -381,27 +366,11 @@ class RerunRecorder(Recorder):
         """The buffered particle subsamples, one row per tick, coloured by their shade."""
         import rerun as rr
 
-        if not self._particle_ticks:
-            return
-        ticks, xy, shade = self._particle_ticks, self._particle_xy, self._particle_shade
-        self._particle_ticks, self._particle_xy, self._particle_shade = [], [], []
-        sizes = np.fromiter((len(part) for part in xy), dtype=np.int64, count=len(xy))
-        weights = np.concatenate(shade).astype(float)
-        # shade = weight / the largest weight of its tick, quantised to 0-255
-        starts = np.cumsum(sizes) - sizes
-        filled = sizes > 0
-        top = np.zeros(len(sizes))
-        if filled.any():
-            top[filled] = np.maximum.reduceat(weights, starts[filled])
-        top = np.repeat(top, sizes)
-        scale = np.divide(255.0, top, out=np.zeros_like(top), where=top > 0)
-        shade = np.clip(np.nan_to_num(weights * scale) + 0.5, 0, 255).astype(np.uint8)
-        shade[np.isnan(weights)] = 128
-        columns = particle_columns(np.concatenate(xy), shade)
-        steps = np.fromiter((step for step, _ in ticks), dtype=np.int64, count=len(ticks))
-        times = np.fromiter((time for _, time in ticks), dtype=float, count=len(ticks))
-        self._send("world/belief/particles", _index(indexes, steps, times),
-                   rr.Points3D.columns(**columns).partition(sizes))
+        if self._particles.count:
+            steps, times, positions, shades, sizes = self._particles.take()
+            colors = _particle_palette()[shades]
+            self._send("world/belief/particles", _index(indexes, steps, times),
+                       rr.Points3D.columns(positions=positions, colors=colors).partition(sizes))
 
     def _send(self, path: str, index: list, columns) -> None:
         self._rec.send_columns(path, indexes=index, columns=columns, strict=True)
@@ -478,7 +447,6 @@ ROW = (
     "mean_x", "mean_y", "n_eff", "rate",
 )
 _NO_DETECTION = (math.nan,) * 8
-_NO_XY, _NO_SHADE = np.zeros((0, 2)), np.zeros(0, dtype=np.uint8)
 
 
 def _row(tick: Tick, rate: float) -> tuple:
@@ -570,6 +538,54 @@ def strips_array(strips):
     points = rr.encodings.Vec3DBatch(flat).as_arrow_array()
     strip_type = pa.list_(pa.field("item", points.type, nullable=False))
     return pa.ListArray.from_arrays(pa.array(offsets), points, type=strip_type)
+
+
+class _ParticleRows:
+    """The particle subsamples of up to ``capacity`` ticks, at most ``limit`` particles per
+    tick (an evenly strided subsample), in arrays allocated once: map-frame positions (m)
+    as float32 points at height Z_PARTICLES, and their weights (NaN where the estimator
+    gives none)."""
+
+    def __init__(self, capacity: int, limit: int) -> None:
+        self.limit = limit
+        self.xyz = np.full((capacity, limit, 3), Z_PARTICLES, dtype=np.float32)
+        self.weights = np.zeros((capacity, limit))
+        self.sizes = np.zeros(capacity, dtype=np.int64)
+        self.steps = np.zeros(capacity, dtype=np.int64)
+        self.times = np.zeros(capacity)
+        self.count = 0
+        self.started = False  # rows begin at the first tick with particles
+
+    def add(self, step: int, time: float, particles: np.ndarray | None, weights: np.ndarray | None) -> None:
+        """A row of (N, >= 2) particles and their (N,) weights; None gives an empty row,
+        which clears the particles shown, once there have been some."""
+        if particles is None and not self.started:
+            return
+        self.started = True
+        row, size = self.count, 0
+        if particles is not None:
+            stride = -(-len(particles) // self.limit) or 1
+            size = -(-len(particles) // stride)
+            self.xyz[row, :size, :2] = particles[::stride, :2]
+            self.weights[row, :size] = np.nan if weights is None else weights[::stride]
+        self.sizes[row], self.steps[row], self.times[row] = size, step, time
+        self.count += 1
+
+    def take(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Empty the rows: (steps (T,), times (T,) s, positions (M, 3), shades (M,) uint8,
+        sizes (T,)), the rows' particles one after the other. A shade is 255 * the weight
+        over its tick's largest weight, rounded; 128 where the weight is NaN."""
+        n, self.count = self.count, 0
+        sizes, weights = self.sizes[:n].copy(), self.weights[:n]
+        held = np.arange(self.limit) < sizes[:, None]
+        unknown = held & np.isnan(weights)
+        top = np.max(np.where(held & ~unknown, weights, 0.0), axis=1, keepdims=True)
+        scale = np.divide(255.0, top, out=np.zeros_like(top), where=top > 0)
+        shades = np.clip(np.where(unknown, 0.0, weights) * scale + 0.5, 0, 255).astype(np.uint8)
+        shades[unknown] = 128
+        kept = np.flatnonzero(held)  # take() copies rows several times faster than a bool mask
+        positions = np.take(self.xyz[:n].reshape(-1, 3), kept, axis=0)
+        return self.steps[:n].copy(), self.times[:n].copy(), positions, shades.ravel()[kept], sizes
 
 
 class _Trail:
@@ -728,12 +744,6 @@ def visibility_outlines(grid, xs: np.ndarray, ys: np.ndarray, thetas: np.ndarray
     poses = (np.asarray(v, dtype=float).reshape(-1) for v in (xs, ys, thetas))
     return march(free_runs(grid), *poses, ox, oy, yaw, _slices(camera.fov, rays), camera.near,
                  camera.far, float(grid.resolution), z, compiled)
-
-
-def particle_columns(xy: np.ndarray, shade: np.ndarray) -> dict[str, np.ndarray]:
-    """Points3D columns of particles: (M, 2) map-frame positions (m) and their shade
-    (uint8, 255 * weight / the tick's largest weight) -> positions and packed RGBA colours."""
-    return {"positions": _xyz(xy, Z_PARTICLES), "colors": _particle_palette()[shade]}
 
 
 @lru_cache(maxsize=1)
