@@ -226,11 +226,12 @@ class VisibilityRegion:
     """The visibility region V^p_k of the camera at one pose, computed on demand.
 
     :attr:`mask` is the whole region of :func:`visibility_region`, computed once. Most
-    consumers need only part of it: the particle filter asks about its particles' cells,
-    which usually lie in a small block of the grid. :meth:`mask_over` marches only the
-    rays that can reach a given block of cells, and only as far as the block. On the block
-    this gives exactly the cells of the whole mask: the same rays are sampled at the same
-    points and stop at the same blocked sample, and no other sample can land in the block.
+    consumers need only part of it: the particle filter asks about its particles' cells
+    (:meth:`holds`), which usually lie in a small block of the grid. :meth:`mask_over`
+    marches only the rays that can reach a given block of cells, and only as far as the
+    block. On the block this gives exactly the cells of the whole mask: the same rays are
+    sampled at the same points and stop at the same blocked sample, and no other sample
+    can land in the block.
     """
 
     def __init__(self, grid: OccupancyGrid, pose: Pose, camera: Camera) -> None:
@@ -277,6 +278,75 @@ class VisibilityRegion:
             _march(grid.blocked, np.cos(towards), np.sin(towards), distances[:samples], first,
                    float(pose.x), float(pose.y), grid_frame(grid), mask)
         return mask
+
+
+    def holds(self, cells: np.ndarray) -> np.ndarray:
+        """Bool (N,): whether the region holds each of the flat cell indices ``cells`` (N,)
+        (row * width + col; negative: no cell, False).
+
+        Cells that cannot meet the field of view (their centres farther than half a cell
+        diagonal from its wedge) are not in the region; the rays are cast only towards the
+        block of the others (:meth:`mask_over`).
+        """
+        cells = np.asarray(cells, dtype=np.int64)
+        if self._mask is not None:
+            return _lookup(self._mask.ravel(), cells, np.ones(cells.size, dtype=np.bool_))
+        grid, pose, camera = self.grid, self.pose, self.camera
+        ox, oy, yaw = grid.origin
+        near_wedge, (r0, r1, c0, c1) = _near_wedge(
+            cells, grid.width, float(pose.x), float(pose.y), float(pose.theta), ox, oy, yaw,
+            float(grid.resolution), camera.fov, camera.far,
+        )
+        if r1 < r0:
+            return near_wedge  # all False
+        return _lookup(self.mask_over((r0, r1), (c0, c1)).ravel(), cells, near_wedge)
+
+
+@njit(cache=True)
+def _lookup(flat_mask, cells, candidates):
+    """flat_mask[cells[i]] where candidates[i] and cells[i] >= 0, else False (N,)."""
+    out = np.zeros(cells.size, dtype=np.bool_)
+    for i in range(cells.size):
+        if candidates[i] and cells[i] >= 0:
+            out[i] = flat_mask[cells[i]]
+    return out
+
+
+@njit(cache=True)
+def _near_wedge(cells, width, px, py, theta, ox, oy, yaw, resolution, fov, far):
+    """(near (N,) bool, (row min, row max, col min, col max) of the near cells): which flat
+    cell indices (negative: none) have their centre within half a cell diagonal (plus a
+    rounding margin) of the field of view's wedge, apex (px, py) (map frame, m), heading
+    theta, opening fov, radius far (m). A cell farther away cannot hold a ray sample of
+    Algorithm 1. For fov > pi every cell within range is near. The bounds are (0, -1,
+    0, -1) when no cell is near."""
+    # Camera and heading in cell coordinates (u along columns, v along rows, in cells).
+    du, dv = (px - ox) / resolution, (py - oy) / resolution
+    u = math.cos(yaw) * du + math.sin(yaw) * dv
+    v = -math.sin(yaw) * du + math.cos(yaw) * dv
+    heading = theta - yaw
+    left_u, left_v = math.cos(heading + 0.5 * fov), math.sin(heading + 0.5 * fov)
+    right_u, right_v = math.cos(heading - 0.5 * fov), math.sin(heading - 0.5 * fov)
+    slack = 0.5 * math.sqrt(2.0) + 1e-6  # cells
+    reach = far / resolution + slack
+    wedge = fov <= math.pi
+    near = np.zeros(cells.size, dtype=np.bool_)
+    r0, r1, c0, c1 = np.iinfo(np.int64).max, -1, np.iinfo(np.int64).max, -1
+    for i in range(cells.size):
+        if cells[i] < 0:
+            continue
+        row, col = cells[i] // width, cells[i] % width
+        x, y = col + 0.5 - u, row + 0.5 - v
+        if x * x + y * y > reach * reach:
+            continue
+        # Signed distances (cells) inside the right and left edges of the wedge.
+        if wedge and (right_u * y - right_v * x < -slack or x * left_v - y * left_u < -slack):
+            continue
+        near[i] = True
+        r0, r1, c0, c1 = min(r0, row), max(r1, row), min(c0, col), max(c1, col)
+    if r1 < 0:
+        return near, (0, -1, 0, -1)
+    return near, (r0, r1, c0, c1)
 
 
 #: cells; how far :func:`_rays_reaching` grows a block to absorb rounding at cell edges

@@ -181,6 +181,29 @@ def test_region_over_a_block_equals_the_whole_mask_there(seed):
     assert partial > 20  # most blocks needed only part of the region
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_region_holds_exactly_the_mask_cells_asked_about(seed):
+    # Clouds of cells around random points, some in view and some behind the camera or out
+    # of range, plus "no cell" entries; FOVs below and above pi.
+    rng = np.random.default_rng(700 + seed)
+    yaw = 0.0 if seed % 2 else 0.8
+    grid = random_grid(rng, 60, 60, 0.05, (rng.uniform(-2, 2), rng.uniform(-2, 2), yaw))
+    skipped = 0
+    for _ in range(40):
+        camera, pose = random_camera(rng), random_free_pose(rng, grid)
+        centre = rng.integers(0, 60, 2)
+        rows = np.clip(centre[0] + rng.integers(-8, 9, 300), 0, 59)
+        cols = np.clip(centre[1] + rng.integers(-8, 9, 300), 0, 59)
+        cells = np.where(rng.random(300) < 0.1, -1, rows * 60 + cols)
+        whole = visibility_region(grid, pose, camera).ravel()
+        expected = np.where(cells >= 0, whole[np.maximum(cells, 0)], False)
+        region = VisibilityRegion(grid, pose, camera)
+        assert np.array_equal(region.holds(cells), expected)
+        skipped += region._mask is None
+        assert np.array_equal(VisibilityRegion.given(whole.reshape(60, 60)).holds(cells), expected)
+    assert skipped == 40  # the whole mask was never needed
+
+
 def test_region_mask_is_computed_once_and_read_only():
     grid = random_grid(np.random.default_rng(5), 40, 40, 0.1)
     region = VisibilityRegion(grid, Pose(2.0, 2.0, 0.3), CAMERA)

@@ -38,9 +38,9 @@ issue #290). The tests compare these against filterpy's.
 Fast path. :meth:`ParticleFilter.update` runs the per-particle arithmetic (unicycle
 motion, cell lookup, blocked and visible tests, weighting) and the covariance in numba
 kernels, and inverts the cumulative weights for resampling in numba. It asks V_k^p only
-about the block of cells its moved particles landed in (``VisibilityRegion.mask_over``),
-so the camera's rays are cast only towards them, with the same answer there as the whole
-mask. The motion draws happen inside the kernel, on the component's Generator through
+about the cells its moved particles landed in (``VisibilityRegion.holds``), so the
+camera's rays are cast only towards those in its field of view, with the same answer as
+the whole mask. The motion draws happen inside the kernel, on the component's Generator through
 numba's ports of numpy's samplers: the same numbers in the same order as the plain numpy
 reference :meth:`ParticleFilter.update_reference`, which the fast path matches bit for
 bit in particles, weights, N_eff and mean (the covariance to round-off); the tests hold
@@ -205,9 +205,8 @@ def _wrap_angle(angle):
 
 @njit(cache=True)
 def _move_and_locate(particles, rng, v_max, turn_rate_std, dt, frame, blocked):
-    """The particles (N, 3) moved by the unicycle model, the flat cell index (N,) each
-    lands in (-1 in a blocked cell or off the grid), and the (row min, row max, col min,
-    col max) of those cells ((0, -1, 0, -1) when all are blocked).
+    """The particles (N, 3) moved by the unicycle model and the flat cell index (N,) each
+    lands in (-1 in a blocked cell or off the grid).
 
     Same draws from ``rng`` as :meth:`ParticleFilter._draw` (numba's Generator runs
     numpy's algorithms on the same bit generator), and :meth:`ParticleFilter._predict`
@@ -234,7 +233,6 @@ def _move_and_locate(particles, rng, v_max, turn_rate_std, dt, frame, blocked):
     cells = np.empty(n, dtype=np.int64)
     ox, oy, rotate, c, s, res = frame
     height, width = blocked.shape
-    row_min, row_max, col_min, col_max = height, -1, width, -1
     for i in range(n):
         dx, dy = moved[i, 0] - ox, moved[i, 1] - oy
         if rotate:
@@ -244,13 +242,8 @@ def _move_and_locate(particles, rng, v_max, turn_rate_std, dt, frame, blocked):
         if not (0.0 <= row < height and 0.0 <= col < width) or blocked[int(row), int(col)]:
             cells[i] = -1
         else:
-            r, k = int(row), int(col)
-            cells[i] = r * width + k
-            row_min, row_max = min(row_min, r), max(row_max, r)
-            col_min, col_max = min(col_min, k), max(col_max, k)
-    if row_max < 0:
-        row_min = col_min = 0
-    return moved, cells, (row_min, row_max, col_min, col_max)
+            cells[i] = int(row) * width + int(col)
+    return moved, cells
 
 
 @njit(cache=True)
@@ -264,21 +257,22 @@ def _exponents(moved, zx, zy, two_sigma2):
 
 
 @njit(cache=True)
-def _weigh_miss(prior, cells, visible, miss_factor):
+def _weigh_miss(prior, cells, seen, miss_factor):
     """Weights (N,) after a miss: prior * miss_factor inside V, prior outside, 0 blocked.
 
-    cells: flat cell index per particle (-1 blocked); visible: flat bool mask of V."""
+    cells: flat cell index per particle (-1 blocked); seen: per particle, whether V holds
+    its cell."""
     weights = np.empty(prior.size)
     for i in range(prior.size):
         if cells[i] < 0:
             weights[i] = 0.0
         else:
-            weights[i] = prior[i] * (miss_factor if visible[cells[i]] else 1.0)
+            weights[i] = prior[i] * (miss_factor if seen[i] else 1.0)
     return weights
 
 
 @njit(cache=True)
-def _weigh_hit(prior, cells, visible, likelihood, seen_boost):
+def _weigh_hit(prior, cells, seen, likelihood, seen_boost):
     """Weights (N,) after a detection: prior * (likelihood * seen_boost inside V, the
     likelihood outside), 0 on blocked cells, where ``likelihood`` is also set to 0."""
     weights = np.empty(prior.size)
@@ -287,7 +281,7 @@ def _weigh_hit(prior, cells, visible, likelihood, seen_boost):
             likelihood[i] = 0.0
             weights[i] = 0.0
         else:
-            weights[i] = prior[i] * (likelihood[i] * (seen_boost if visible[cells[i]] else 1.0))
+            weights[i] = prior[i] * (likelihood[i] * (seen_boost if seen[i] else 1.0))
     return weights
 
 
@@ -416,12 +410,11 @@ class ParticleFilter(Estimator):
         weights (N,) and, with a detection, its likelihood (N,) (0 on blocked cells;
         else None), by the kernels."""
         cfg = self.config
-        moved, cells, (r0, r1, c0, c1) = _move_and_locate(
+        moved, cells = _move_and_locate(
             self.particles, self.rng, self.context.evader.v_max, cfg.turn_rate_std, dt,
             self._frame, self.context.grid.blocked,
         )
-        # Only the block of cells the particles landed in is asked for (module docstring).
-        seen = self._flat_mask(visible.mask_over((r0, r1), (c0, c1)))
+        seen = visible.holds(cells)  # V only where the particles are (module docstring)
         if detection is None:
             return moved, _weigh_miss(self.weights, cells, seen, cfg.miss_factor), None
         zx, zy = detection.position

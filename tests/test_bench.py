@@ -1,0 +1,28 @@
+"""Smoke tests of pegame.bench's measurements on small inputs (the figures themselves are
+measured by ``python -m pegame.bench``, never asserted here)."""
+
+from __future__ import annotations
+
+import math
+
+from pegame.bench import bench_decisions, format_report, machine
+from pegame.config import resolve_map_path
+from pegame.maps import load_map
+
+
+def test_decision_benchmarks_time_each_part_on_a_paper_map():
+    grid = load_map(resolve_map_path("maps/enclosed.yaml"))
+    timings = bench_decisions(grid, 3)
+    assert set(timings) == {"pursuer_decision_ms", "evader_decision_ms", "pf_step_ms"}
+    assert all(math.isfinite(ms) and ms > 0 for ms in timings.values())
+
+
+def test_report_text_shows_missing_figures_as_dashes():
+    report = {"machine": machine(), "jit_warmup_s": 1.0, "maps": {}, "sim_steps_per_s": 1000.0}
+    report.update(dict.fromkeys((
+        "rr_games_per_s", "ss_games_per_s", "recorder_overhead", "rrd_mb_per_game",
+        "env_steps_per_s", "pybullet_rtf", "vision_precision", "vision_recall",
+        "large_map_decision_ms", "large_map_peak_mb",
+    )))
+    text = format_report(report)
+    assert "machine:" in text and "S-S -" in text and "recorder: +-% game time" in text
