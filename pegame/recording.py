@@ -22,7 +22,8 @@ world/pursuer/pose         Points3D, a ball of the body radius          every ti
 world/pursuer/heading      Arrows3D                                     every tick
 world/pursuer/trajectory   LineStrips3D, positions so far, one every ``trail_every``
                            ticks; logged at those ticks and at the last one
-world/pursuer/fov          LineStrips3D, ``geometry.fov_wedge``         every tick
+world/pursuer/fov          LineStrips3D, ``geometry.fov_wedge`` at the zero pose (static),
+                           placed by a Transform3D                      every tick
 world/pursuer/visible      LineStrips3D, outline of the visibility region every tick
 world/pursuer/path, goal   the current plan's path and goal            new plans
 world/evader/...           pose, heading, trajectory, path and goal (the chosen
@@ -209,6 +210,9 @@ class RerunRecorder(Recorder):
         w, h = ctx.camera.image_width, ctx.camera.image_height
         border = [[(0, 0), (w, 0), (w, h), (0, h), (0, 0)]]
         rec.log("camera/frame", rr.LineStrips2D(border, colors=[(128, 128, 128)]), static=True)
+        wedge = _xyz(fov_template(ctx.camera), Z_REGION)
+        rec.log("world/pursuer/fov", rr.LineStrips3D([wedge], colors=[(*PURSUER[:3], 160)], radii=[0.015]),
+                static=True)
         dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's, when there, is faster
         text = f"```yaml\n{yaml.dump(properties, Dumper=dumper, sort_keys=False)}```\n"
         rec.log("config", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
@@ -291,6 +295,8 @@ class RerunRecorder(Recorder):
 
     def _log_plans(self, tick: Tick) -> None:
         """Paths, goals and candidates, only when a strategy has made a new plan."""
+        if tick.plans[0] is self._plans[0] and tick.plans[1] is self._plans[1]:
+            return
         import rerun as rr
 
         for index, name in enumerate(("pursuer", "evader")):
@@ -314,11 +320,11 @@ class RerunRecorder(Recorder):
 
     def _log_events(self, tick: Tick) -> None:
         """A TextLog line when the detector loses or reacquires the evader."""
-        import rerun as rr
-
         detected = tick.detection is not None
         if detected == self._detected:
             return
+        import rerun as rr
+
         if self._detected is None:
             text, level = ("evader detected at start", "INFO") if detected else ("evader not detected at start", "WARN")
         elif detected:
@@ -330,12 +336,12 @@ class RerunRecorder(Recorder):
 
     def _log_image(self, tick: Tick) -> None:
         """The camera image as JPEG, logged directly: it is rare and large."""
-        import rerun as rr
-
         rgb = tick.frame.rgb
         every = self.config.image_every
         if rgb is None or every == 0 or tick.step % every:
             return
+        import rerun as rr
+
         self._rec.set_time(STEP, sequence=tick.step)
         self._rec.set_time(SIM_TIME, duration=tick.time)
         size = (self.context.camera.image_width, self.context.camera.image_height)
@@ -397,8 +403,11 @@ class RerunRecorder(Recorder):
             self._send(f"world/{name}/pose", every, rr.Points3D.columns(positions=here))
             self._send(f"world/{name}/heading", every, rr.Arrows3D.columns(origins=here, vectors=heading))
         ctx = self.context
-        wedges = _placed(fov_template(ctx.camera), c["px"], c["py"], c["ptheta"], Z_REGION)
-        self._send("world/pursuer/fov", every, rr.LineStrips3D.columns(strips=strips_array(wedges)))
+        half = 0.5 * c["ptheta"]
+        rotation = np.zeros((len(half), 4), dtype=np.float32)  # quaternions (x, y, z, w) about z
+        rotation[:, 2], rotation[:, 3] = np.sin(half), np.cos(half)
+        wedge = rr.Transform3D.columns(translation=_stack(c["px"], c["py"], 0.0), quaternion=rotation)
+        self._send("world/pursuer/fov", every, wedge)
         outlines = visibility_outlines(ctx.grid, c["px"], c["py"], c["ptheta"], ctx.camera,
                                        self.config.outline_rays, Z_REGION)
         self._send("world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips_array(outlines)))
@@ -531,10 +540,15 @@ def strips_array(strips):
     import pyarrow as pa
     import rerun as rr
 
-    lengths = [len(strip) for strip in strips]
-    flat = np.concatenate(strips) if lengths else np.zeros((0, 3), np.float32)
-    offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
-    offsets[1:] = np.cumsum(lengths)
+    if isinstance(strips, np.ndarray):
+        n, k = strips.shape[:2]
+        flat = strips.reshape(n * k, 3)
+        offsets = np.arange(0, (n + 1) * k, k, dtype=np.int32) if k else np.zeros(n + 1, np.int32)
+    else:
+        lengths = [len(strip) for strip in strips]
+        flat = np.concatenate(strips) if lengths else np.zeros((0, 3), np.float32)
+        offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
+        offsets[1:] = np.cumsum(lengths)
     points = rr.encodings.Vec3DBatch(flat).as_arrow_array()
     strip_type = pa.list_(pa.field("item", points.type, nullable=False))
     return pa.ListArray.from_arrays(pa.array(offsets), points, type=strip_type)
@@ -617,17 +631,6 @@ def _xyz(xy, z: float) -> np.ndarray:
     return _stack(xy[:, 0], xy[:, 1], z)
 
 
-def _placed(shape: np.ndarray, x: np.ndarray, y: np.ndarray, theta: np.ndarray, z: float) -> np.ndarray:
-    """(n, K, 3) float32 copies of the (K, 2) ``shape`` (given at the zero pose) moved to
-    the n poses (x, y, theta) (map frame, m and rad), at height z."""
-    c, s = np.cos(theta)[:, None], np.sin(theta)[:, None]
-    out = np.empty((len(x), len(shape), 3), dtype=np.float32)
-    out[..., 0] = x[:, None] + c * shape[:, 0] - s * shape[:, 1]
-    out[..., 1] = y[:, None] + s * shape[:, 0] + c * shape[:, 1]
-    out[..., 2] = z
-    return out
-
-
 @lru_cache(maxsize=16)
 def fov_template(camera) -> np.ndarray:
     """The camera's FOV wedge (``geometry.fov_wedge``) at the zero pose, (K, 2) m."""
@@ -636,12 +639,14 @@ def fov_template(camera) -> np.ndarray:
     return fov_wedge(camera, Pose(0.0, 0.0, 0.0), n=16)
 
 
-def _outlines(runs, xs, ys, thetas, ox, oy, yaw, slices, near, far, resolution, z, jump):
-    """Closed (2 n + 1, 3) float32 polygons around the visibility regions of the camera at
-    the poses (xs, ys, thetas) (map frame, m and rad), one per pose; n = len(slices[0]).
+def _outlines(runs, xs, ys, thetas, ox, oy, yaw, slices, arc, near, far, resolution, z, jump):
+    """Closed (n + m + 1, 3) float32 polygons around the visibility regions of the camera
+    at the poses (xs, ys, thetas) (map frame, m and rad), one per pose: the far ends of n
+    rays, then m points back along the near arc; n = len(slices[0]), m = len(arc[0]).
 
     See :func:`visibility_outlines`. Rays leave each pose at theta + a_i, where slices =
-    (cos a_i, sin a_i) (a_i in rad from the optical axis), and are sampled in the grid
+    (cos a_i, sin a_i) (a_i in rad from the optical axis; arc likewise gives the near
+    arc's angles), and are sampled in the grid
     frame one cell apart, up to the first sample in a blocked cell (``runs`` 0, see
     :func:`free_runs`) or off the grid. With ``jump`` the samples that ``runs`` shows to be
     free are skipped, which gives the same result as sampling every cell (the plain
@@ -649,8 +654,9 @@ def _outlines(runs, xs, ys, thetas, ox, oy, yaw, slices, near, far, resolution, 
     """
     height, width = runs.shape
     slice_cos, slice_sin = slices
-    n = slice_cos.size
-    out = np.empty((xs.size, 2 * n + 1, 3), dtype=np.float32)
+    arc_cos, arc_sin = arc
+    n, m = slice_cos.size, arc_cos.size
+    out = np.empty((xs.size, n + m + 1, 3), dtype=np.float32)
     c, s = math.cos(yaw), math.sin(yaw)
     # Cells that straddle the near range are only partly seen: reach starts one cell beyond it.
     start = near / resolution + 1.0
@@ -680,9 +686,11 @@ def _outlines(runs, xs, ys, thetas, ox, oy, yaw, slices, near, far, resolution, 
             cw = cm * slice_cos[i] - sm * slice_sin[i]
             sw = sm * slice_cos[i] + cm * slice_sin[i]
             out[p, i, 0], out[p, i, 1], out[p, i, 2] = x + reach * cw, y + reach * sw, z
-            k = 2 * n - 1 - i
-            out[p, k, 0], out[p, k, 1], out[p, k, 2] = x + near * cw, y + near * sw, z
-        out[p, 2 * n] = out[p, 0]
+        for j in range(m):
+            cw = cm * arc_cos[j] - sm * arc_sin[j]
+            sw = sm * arc_cos[j] + cm * arc_sin[j]
+            out[p, n + j, 0], out[p, n + j, 1], out[p, n + j, 2] = x + near * cw, y + near * sw, z
+        out[p, n + m] = out[p, 0]
     return out
 
 
@@ -726,10 +734,22 @@ def _slices(fov: float, rays: int) -> tuple[np.ndarray, np.ndarray]:
     return np.cos(angles), np.sin(angles)
 
 
+#: points along the near arc of an outline (the arc is short: near is a few decimetres)
+NEAR_ARC_POINTS = 8
+
+
+@lru_cache(maxsize=16)
+def _near_arc(fov: float) -> tuple[np.ndarray, np.ndarray]:
+    """(cos, sin) of NEAR_ARC_POINTS angles from +fov/2 back to -fov/2 (rad)."""
+    angles = np.linspace(0.5 * fov, -0.5 * fov, NEAR_ARC_POINTS)
+    return np.cos(angles), np.sin(angles)
+
+
 def visibility_outlines(grid, xs: np.ndarray, ys: np.ndarray, thetas: np.ndarray, camera,
                         rays: int, z: float = 0.0, compiled: bool = True) -> np.ndarray:
-    """(P, 2 rays + 1, 3) float32: closed polygons (map frame, m, at height z) around the
-    visibility regions of the camera at P poses (xs, ys, thetas) (m, m, rad) on ``grid``.
+    """(P, rays + NEAR_ARC_POINTS + 1, 3) float32: closed polygons (map frame, m, at height
+    z) around the visibility regions of the camera at P poses (xs, ys, thetas) (m, m, rad)
+    on ``grid``.
 
     ``rays`` rays at the centres of equal slices of the FOV are cast from the camera one
     cell at a time up to the first blocked cell or the far range; each polygon runs along
@@ -742,8 +762,8 @@ def visibility_outlines(grid, xs: np.ndarray, ys: np.ndarray, thetas: np.ndarray
     ox, oy, yaw = grid.origin
     march = _outlines_kernel() if compiled else _outlines
     poses = (np.asarray(v, dtype=float).reshape(-1) for v in (xs, ys, thetas))
-    return march(free_runs(grid), *poses, ox, oy, yaw, _slices(camera.fov, rays), camera.near,
-                 camera.far, float(grid.resolution), z, compiled)
+    return march(free_runs(grid), *poses, ox, oy, yaw, _slices(camera.fov, rays),
+                 _near_arc(camera.fov), camera.near, camera.far, float(grid.resolution), z, compiled)
 
 
 @lru_cache(maxsize=1)
@@ -801,7 +821,6 @@ def _styles(pursuer_radius: float, evader_radius: float) -> dict[str, Any]:
         "world/detection": rr.Points3D.from_fields(colors=[DETECTION], radii=[0.12]),
         "world/belief/mean": rr.Points3D.from_fields(colors=[ESTIMATE], radii=[0.12]),
         "world/belief/particles": rr.Points3D.from_fields(radii=[0.04]),
-        "world/pursuer/fov": rr.LineStrips3D.from_fields(colors=[faded(PURSUER)], radii=[0.015]),
         "world/pursuer/visible": rr.LineStrips3D.from_fields(colors=[(255, 140, 0, 255)], radii=[0.025]),
         "world/evader/candidates": rr.Points3D.from_fields(colors=[faded(EVADER)], radii=[0.08]),
         "camera/detection": rr.Boxes2D.from_fields(colors=[DETECTION]),

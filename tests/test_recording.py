@@ -33,7 +33,7 @@ from pegame.api import (
 )
 from pegame.figures import plot_trajectory
 from pegame.game import Game
-from pegame.geometry import VisibilityRegion, visibility_region
+from pegame.geometry import VisibilityRegion, fov_wedge, visibility_region
 from pegame.maps import OccupancyGrid
 from pegame.recording import RerunRecorder, recording_id, visibility_outlines
 from pegame.replay import find_recordings, main as replay_main, viewer_command
@@ -106,6 +106,33 @@ def test_entities_have_one_row_per_step(played):
         assert 1 <= len(steps[entity]) <= TICKS // 10 + 1, entity
     assert steps["/events"], "the start of tracking is an event"
     assert len(blueprints) == 1
+
+
+def test_fov_wedge_is_placed_at_the_pursuer_pose_every_step(played):
+    from rerun.chunk import RrdReader
+
+    game, outcome, out_dir = played
+    strips, moves = None, {}
+    for chunk in RrdReader(out_dir / "game.rrd").stream().to_chunks():
+        if chunk.entity_path != "/world/pursuer/fov":
+            continue
+        batch = chunk.to_record_batch()
+        if chunk.is_static:
+            strips = np.array(batch.column("LineStrips3D:strips").to_pylist()[0][0])
+        else:
+            for step, t, q in zip(batch.column("step").to_pylist(),
+                                  batch.column("Transform3D:translation").to_pylist(),
+                                  batch.column("Transform3D:quaternion").to_pylist()):
+                moves[step] = (np.array(t[0]), np.array(q[0]))
+    assert strips is not None and sorted(moves) == list(range(TICKS))
+    for row in outcome.trajectory:
+        step, pose = row[0], Pose(*row[2:5])
+        (tx, ty, _), (qx, qy, qz, qw) = moves[step]
+        angle = 2.0 * math.atan2(qz, qw)
+        assert qx == qy == 0.0
+        c, s = math.cos(angle), math.sin(angle)
+        placed = np.column_stack([tx + c * strips[:, 0] - s * strips[:, 1], ty + s * strips[:, 0] + c * strips[:, 1]])
+        np.testing.assert_allclose(placed, fov_wedge(game.camera, pose, n=16), atol=1e-5)
 
 
 def test_recording_does_not_change_the_game(played, compose_config, tmp_path):
@@ -254,7 +281,7 @@ def test_visibility_outlines_match_their_reference_and_bound_the_region(origin):
     fast = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01)
     slow = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01, compiled=False)
     np.testing.assert_array_equal(fast, slow)
-    assert fast.shape == (60, 129, 3) and np.array_equal(fast[:, 0], fast[:, -1])
+    assert fast.shape == (60, 64 + 8 + 1, 3) and np.array_equal(fast[:, 0], fast[:, -1])
     in_region = []
     for outline, x, y, theta in zip(fast, xs, ys, thetas):
         mask = visibility_region(grid, Pose(x, y, theta), camera)

@@ -89,8 +89,9 @@ log = logging.getLogger(__name__)
 
 DISTANCES = ("euclidean", "geodesic")
 
-#: most candidate points put into Plan.info["candidates"] for the recorder
-MAX_RECORDED_CANDIDATES = 2000
+#: most candidate points put into Plan.info["candidates"] for the recorder (an evenly
+#: strided subsample: enough to show the set, few enough not to hide the map)
+MAX_RECORDED_CANDIDATES = 500
 #: edge (cells) of the square tiles that the fast argmin search scores or skips as a whole
 TILE = 8
 #: a tile is skipped only when its cost bound exceeds the best cost by this relative
