@@ -102,14 +102,17 @@ def bench_sim_steps(grid: OccupancyGrid, steps: int) -> float:
     return steps / (time.perf_counter() - start)
 
 
+def game_seconds(overrides: list[str], out_dir: str) -> float:
+    """Wall-clock time (s) of playing one game (not building it)."""
+    game = Game(compose(overrides))
+    start = time.perf_counter()
+    game.play(out_dir)
+    return time.perf_counter() - start
+
+
 def games_per_second(overrides: list[str], games: int, out_dir: str) -> float:
     """Whole games per second (median game time), recorder as the overrides say."""
-    times = []
-    for seed in range(games):
-        game = Game(compose([*overrides, f"game.seed={seed}"]))
-        start = time.perf_counter()
-        game.play(out_dir)
-        times.append(time.perf_counter() - start)
+    times = [game_seconds([*overrides, f"game.seed={seed}"], out_dir) for seed in range(games)]
     return 1.0 / statistics.median(times)
 
 
@@ -198,15 +201,24 @@ def _large_map_worker(repeat: int) -> tuple[float | None, float]:
 
 
 def recorder_cost(games: int, out_dir: str) -> tuple[float | None, float | None]:
-    """(fractional extra time of recording an S-S game with recorder=rerun, MB per .rrd)."""
+    """(fractional extra time of recording an S-S game with recorder=rerun, MB per .rrd).
+
+    Each seed is played without and then with the recorder, one right after the other,
+    and the figure is the median of the per-seed ratios: on a shared machine, neighbouring
+    games see the same load."""
     if not all("smart" in registry.available(g) for g in ("pursuer", "evader")):
         return None, None
     base = ["pursuer=smart", "evader=smart", "env=enclosed"]
     games_per_second([*base, "recorder=rerun"], 1, out_dir)  # imports rerun-sdk, compiles the outline kernel
-    plain = 1.0 / games_per_second([*base, "recorder=none"], games, out_dir)
-    recorded = 1.0 / games_per_second([*base, "recorder=rerun"], games, out_dir)
+    ratios = []
+    for seed in range(games):
+        plain, recorded = (
+            game_seconds([*base, f"recorder={recorder}", f"game.seed={seed}"], out_dir)
+            for recorder in ("none", "rerun")
+        )
+        ratios.append(recorded / plain - 1.0)
     sizes = [p.stat().st_size for p in Path(out_dir).glob("*.rrd")]
-    return recorded / plain - 1.0, (max(sizes) / 2**20 if sizes else None)
+    return statistics.median(ratios), (max(sizes) / 2**20 if sizes else None)
 
 
 def env_steps_per_second(seconds: float) -> float | None:
@@ -273,7 +285,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         smart = all("smart" in registry.available(g) for g in ("pursuer", "evader"))
         ss = ["pursuer=smart", "evader=smart", "recorder=none", "env=enclosed"]
         report["ss_games_per_s"] = games_per_second(ss, games, tmp) if smart else None
-        report["recorder_overhead"], report["rrd_mb_per_game"] = recorder_cost(games, tmp)
+        report["recorder_overhead"], report["rrd_mb_per_game"] = recorder_cost(3 * games, tmp)
     report["large_map_decision_ms"], report["large_map_peak_mb"] = large_map_decision(max(5, repeat // 10))
     report["env_steps_per_s"] = env_steps_per_second(2 if args.quick else 10)
     report.update(plugin_figures(args.quick))
