@@ -24,6 +24,8 @@ vectorised numpy over all rays and samples, and the numba ray march behind
 :func:`line_of_sight` is a numba kernel with the numpy reference
 ``_line_of_sight_reference``. The small numba helpers :func:`grid_frame`,
 :func:`point_cell` and :func:`cell_blocked` serve other modules' kernels too.
+:class:`VisibilityRegion` computes the same mask on demand, or only the part of it that
+a caller asks about; :func:`body_in_view` extends :func:`in_view` from a point to a body.
 """
 
 from __future__ import annotations
@@ -244,7 +246,8 @@ class VisibilityRegion:
         tests; :meth:`mask_over` returns the mask itself."""
         region = cls.__new__(cls)
         region.grid = region.pose = region.camera = None
-        region._mask = np.asarray(mask, dtype=bool)
+        region._mask = np.asarray(mask, dtype=bool).view()
+        region._mask.setflags(write=False)
         return region
 
     @property
@@ -278,7 +281,6 @@ class VisibilityRegion:
             _march(grid.blocked, np.cos(towards), np.sin(towards), distances[:samples], first,
                    float(pose.x), float(pose.y), grid_frame(grid), mask)
         return mask
-
 
     def holds(self, cells: np.ndarray) -> np.ndarray:
         """Bool (N,): whether the region holds each of the flat cell indices ``cells`` (N,)
