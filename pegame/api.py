@@ -348,7 +348,8 @@ class Estimator(Plugin):
     ) -> Belief:
         """Predict dt seconds (s) ahead and correct with this tick's detection (or its
         absence) and the pursuer's visibility region (``visible.mask`` is a bool (H, W) mask
-        over the grid; ``visible.mask_over`` computes only a block of it)."""
+        over the grid; ``visible.holds(cells)`` answers for a few cells, at a fraction of
+        the cost)."""
 
 
 class Strategy(Plugin):

@@ -304,6 +304,14 @@ class VisibilityRegion:
         return _lookup(self.mask_over((r0, r1), (c0, c1)).ravel(), cells, near_wedge)
 
 
+@njit(cache=True, inline="always")
+def _in_cells(x, y, ox, oy, yaw, resolution):
+    """(u, v): the map point (x, y) (m) in continuous cell coordinates, u along columns and
+    v along rows, from the grid origin (ox, oy, yaw) (m, m, rad); not floored."""
+    du, dv = (x - ox) / resolution, (y - oy) / resolution
+    return math.cos(yaw) * du + math.sin(yaw) * dv, -math.sin(yaw) * du + math.cos(yaw) * dv
+
+
 @njit(cache=True)
 def _lookup(flat_mask, cells, candidates):
     """flat_mask[cells[i]] where candidates[i] and cells[i] >= 0, else False (N,)."""
@@ -322,11 +330,8 @@ def _near_wedge(cells, width, px, py, theta, ox, oy, yaw, resolution, fov, far):
     theta, opening fov, radius far (m). A cell farther away cannot hold a ray sample of
     Algorithm 1. For fov > pi every cell within range is near. The bounds are (0, -1,
     0, -1) when no cell is near."""
-    # Camera and heading in cell coordinates (u along columns, v along rows, in cells).
-    du, dv = (px - ox) / resolution, (py - oy) / resolution
-    u = math.cos(yaw) * du + math.sin(yaw) * dv
-    v = -math.sin(yaw) * du + math.cos(yaw) * dv
-    heading = theta - yaw
+    u, v = _in_cells(px, py, ox, oy, yaw, resolution)
+    heading = theta - yaw  # in the grid frame
     left_u, left_v = math.cos(heading + 0.5 * fov), math.sin(heading + 0.5 * fov)
     right_u, right_v = math.cos(heading - 0.5 * fov), math.sin(heading - 0.5 * fov)
     slack = 0.5 * math.sqrt(2.0) + 1e-6  # cells
@@ -375,10 +380,7 @@ def _rays_reaching(angles, angle_step, distance_step, n_distances, px, py, theta
     m). The block is grown by _REACH_MARGIN cells, and one ray and one sample more are
     taken on every side, so rounding at cell edges cannot hide a sample.
     """
-    # Cell coordinates: u along columns, v along rows, in cells from the grid origin.
-    du, dv = (px - ox) / resolution, (py - oy) / resolution
-    u = math.cos(yaw) * du + math.sin(yaw) * dv
-    v = -math.sin(yaw) * du + math.cos(yaw) * dv
+    u, v = _in_cells(px, py, ox, oy, yaw, resolution)
     us = (col0 - _REACH_MARGIN - u, col1 + 1 + _REACH_MARGIN - u)
     vs = (row0 - _REACH_MARGIN - v, row1 + 1 + _REACH_MARGIN - v)
     reach = 0.0

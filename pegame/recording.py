@@ -57,8 +57,8 @@ per-entity buffers, all sent with ``send_columns`` every ``flush_every`` ticks (
 entity; ``live_flush_every`` when a viewer is spawned); styles and the FOV wedge are
 logged once as static, the wedge placed by a transform per tick; the visibility region
 is drawn as an outline (rays cast on the grid in one compiled batch per send) and the
-particles as a subsample. A failure to write (unwritable directory, full disk) or any other error while
-recording disables the recorder with one warning; the game goes on.
+particles as a subsample. A failure to write (unwritable directory, full disk) or any
+other error while recording disables the recorder with one warning; the game goes on.
 """
 
 from __future__ import annotations
@@ -208,7 +208,8 @@ class RerunRecorder(Recorder):
 
         rec, ctx = self._rec, self.context
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-        rec.log("world/map", _cached_grid_map(ctx.grid), static=True)
+        # The map is static; building its payload is the larger part of starting a recording.
+        rec.log("world/map", _per_grid("grid_map", ctx.grid, grid_map), static=True)
         w, h = ctx.camera.image_width, ctx.camera.image_height
         border = [[(0, 0), (w, 0), (w, h), (0, h), (0, 0)]]
         rec.log("camera/frame", rr.LineStrips2D(border, colors=[(128, 128, 128)]), static=True)
@@ -648,11 +649,10 @@ def _outlines(runs, xs, ys, thetas, ox, oy, yaw, slices, arc, near, far, resolut
 
     See :func:`visibility_outlines`. Rays leave each pose at theta + a_i, where slices =
     (cos a_i, sin a_i) (a_i in rad from the optical axis; arc likewise gives the near
-    arc's angles), and are sampled in the grid
-    frame one cell apart, up to the first sample in a blocked cell (``runs`` 0, see
-    :func:`free_runs`) or off the grid. With ``jump`` the samples that ``runs`` shows to be
-    free are skipped, which gives the same result as sampling every cell (the plain
-    reference, jump=False).
+    arc's angles), and are sampled in the grid frame one cell apart, up to the first
+    sample in a blocked cell (``runs`` 0, see :func:`free_runs`) or off the grid. With
+    ``jump`` the samples that ``runs`` shows to be free are skipped, which gives the
+    same result as sampling every cell (the plain reference, jump=False).
     """
     height, width = runs.shape
     slice_cos, slice_sin = slices
@@ -704,9 +704,6 @@ def _outlines_kernel():
     return njit(cache=True)(_outlines)
 
 
-_RUNS: dict[int, tuple[Any, np.ndarray]] = {}
-
-
 def free_runs(grid) -> np.ndarray:
     """uint8 (H, W): 0 on blocked cells; on a free cell, how many samples one cell apart
     along any ray from any point of the cell are sure to be free, this one included.
@@ -716,16 +713,16 @@ def free_runs(grid) -> np.ndarray:
     floor(D - 1.5) samples (at least 1, at most 255). Small, so it stays in cache. Kept for
     the next games of the process on the same grid.
     """
-    hit = _RUNS.get(id(grid))
-    if hit is None or hit[0] is not grid:
-        from scipy.ndimage import distance_transform_edt
+    return _per_grid("free_runs", grid, _free_runs)
 
-        free = np.pad(~grid.blocked, 1, constant_values=False)
-        clearance = distance_transform_edt(free)[1:-1, 1:-1]
-        runs = np.where(grid.blocked, 0, 1 + np.clip(np.floor(clearance - 1.5), 0, 254))
-        _RUNS.clear()
-        hit = _RUNS[id(grid)] = (grid, runs.astype(np.uint8))
-    return hit[1]
+
+def _free_runs(grid) -> np.ndarray:
+    from scipy.ndimage import distance_transform_edt
+
+    free = np.pad(~grid.blocked, 1, constant_values=False)
+    clearance = distance_transform_edt(free)[1:-1, 1:-1]
+    runs = np.where(grid.blocked, 0, 1 + np.clip(np.floor(clearance - 1.5), 0, 254))
+    return runs.astype(np.uint8)
 
 
 @lru_cache(maxsize=16)
@@ -776,16 +773,15 @@ def _particle_palette() -> np.ndarray:
     return (rgba[:, 0] << 24) | (rgba[:, 1] << 16) | (rgba[:, 2] << 8) | rgba[:, 3]
 
 
-_GRID_MAPS: dict[int, tuple[Any, Any]] = {}
+_PER_GRID: dict[str, tuple[Any, Any]] = {}
 
 
-def _cached_grid_map(grid):
-    """:func:`grid_map` of ``grid``, kept for the next games of the process on the same grid
-    (the map is static; building its payload is the larger part of starting a recording)."""
-    hit = _GRID_MAPS.get(id(grid))
+def _per_grid(name: str, grid, build):
+    """``build(grid)``, kept under ``name`` for the next games of the process on the same
+    grid (grids are immutable; one grid per name is kept)."""
+    hit = _PER_GRID.get(name)
     if hit is None or hit[0] is not grid:
-        _GRID_MAPS.clear()
-        hit = _GRID_MAPS[id(grid)] = (grid, grid_map(grid))
+        hit = _PER_GRID[name] = (grid, build(grid))
     return hit[1]
 
 

@@ -40,14 +40,14 @@ motion, cell lookup, blocked and visible tests, weighting) and the covariance in
 kernels, and inverts the cumulative weights for resampling in numba. It asks V_k^p only
 about the cells its moved particles landed in (``VisibilityRegion.holds``), so the
 camera's rays are cast only towards those in its field of view, with the same answer as
-the whole mask. The motion draws happen inside the kernel, on the component's Generator through
-numba's ports of numpy's samplers: the same numbers in the same order as the plain numpy
-reference :meth:`ParticleFilter.update_reference`, which the fast path matches bit for
-bit in particles, weights, N_eff and mean (the covariance to round-off); the tests hold
-it to that. Three steps stay numpy calls on purpose, because the numba equivalents round
-differently: ``np.exp`` (numpy's SIMD exp differs from libm's in the last bit), and the
-sums and dot products behind the normalisation, N_eff and the mean (numpy's pairwise
-sums and BLAS).
+the whole mask. The motion draws happen inside the kernel, on the component's Generator
+through numba's ports of numpy's samplers: the same numbers in the same order as the
+plain numpy reference :meth:`ParticleFilter.update_reference`, which the fast path
+matches bit for bit in particles, weights, N_eff and mean (the covariance to round-off);
+the tests hold it to that. Three steps stay numpy calls on purpose, because the numba
+equivalents round differently: ``np.exp`` (numpy's SIMD exp differs from libm's in the
+last bit), and the sums and dot products behind the normalisation, N_eff and the mean
+(numpy's pairwise sums and BLAS).
 """
 
 from __future__ import annotations

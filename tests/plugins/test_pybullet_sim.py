@@ -164,15 +164,7 @@ def test_reset_close_cycles_keep_memory_flat(context):
     assert _rss_mb() - before < 5.0
 
 
-def test_missing_pybullet_is_an_import_error_naming_it(monkeypatch):
-    import sys
-
-    from pegame import registry
-
-    monkeypatch.setitem(sys.modules, "pybullet", None)
-    for name in [m for m in sys.modules if m.startswith("pegame_pybullet")]:
-        monkeypatch.delitem(sys.modules, name)
-    with pytest.raises(registry.PluginError) as info:
-        registry.load("sim", "pybullet")
-    assert "pybullet" in str(info.value) and "pip install pybullet" in str(info.value)
-    assert isinstance(info.value.__cause__, ImportError)
+def test_missing_pybullet_is_an_import_error_naming_it(load_without):
+    error = load_without("pybullet", "pegame_pybullet", "sim", "pybullet")
+    assert "pybullet" in str(error) and "pip install pybullet" in str(error)
+    assert isinstance(error.__cause__, ImportError)

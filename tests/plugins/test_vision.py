@@ -9,11 +9,9 @@ pytest.importorskip("pybullet")  # the frames are rendered by sim=pybullet
 
 import dataclasses  # noqa: E402
 import math  # noqa: E402
-import sys  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from pegame import registry  # noqa: E402
 from pegame.api import Body, Camera, Context, Pose, SensorFrame  # noqa: E402
 from pegame.errors import ConfigError  # noqa: E402
 from pegame.maps import OccupancyGrid  # noqa: E402
@@ -92,11 +90,7 @@ def test_bad_colours_are_config_errors():
         VisionDetector.Config(colours=["red"])
 
 
-def test_missing_opencv_is_an_import_error_naming_it(monkeypatch):
-    monkeypatch.setitem(sys.modules, "cv2", None)
-    for name in [m for m in sys.modules if m.startswith("pegame_vision")]:
-        monkeypatch.delitem(sys.modules, name)
-    with pytest.raises(registry.PluginError) as info:
-        registry.load("detector", "vision")
-    assert "cv2" in str(info.value) and "pip install opencv-python-headless" in str(info.value)
-    assert isinstance(info.value.__cause__, ImportError)
+def test_missing_opencv_is_an_import_error_naming_it(load_without):
+    error = load_without("cv2", "pegame_vision", "detector", "vision")
+    assert "cv2" in str(error) and "pip install opencv-python-headless" in str(error)
+    assert isinstance(error.__cause__, ImportError)
