@@ -38,6 +38,7 @@ from numba import njit
 
 from pegame.api import Camera, Pose, wrap_angle
 from pegame.maps import OccupancyGrid
+from pegame.trig import MAX_ANGLE, sin_cos
 
 
 def _inclusive_range(stop: float, step: float) -> np.ndarray:
@@ -65,8 +66,24 @@ def _ray_tables(camera: Camera) -> tuple[np.ndarray, np.ndarray, int]:
 
 def _ray_directions(pose: Pose, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
     """Unit direction (cos, sin) of every ray of ``camera`` at ``pose``, map frame."""
-    angles = pose.theta + _ray_tables(camera)[0]
-    return np.cos(angles), np.sin(angles)
+    angles = _ray_tables(camera)[0]
+    return _directions(float(pose.theta), angles, 0, angles.size)
+
+
+@njit(cache=True)
+def _directions(theta, angles, first, stop):
+    """Unit directions (cos, sin) (each (stop - first,)) of the rays at angles[first:stop]
+    (rad) from the heading theta (rad), by the vectorised :func:`pegame.trig.sin_cos`.
+    Every path takes its directions from here, so they all sample the same points."""
+    count = stop - first
+    cos_a, sin_a = np.empty(count), np.empty(count)
+    for i in range(count):
+        sin_a[i], cos_a[i] = sin_cos(theta + angles[first + i])
+    if not abs(theta) <= MAX_ANGLE - math.pi:  # beyond sin_cos's range: libm's
+        for i in range(count):
+            towards = theta + angles[first + i]
+            cos_a[i], sin_a[i] = math.cos(towards), math.sin(towards)
+    return cos_a, sin_a
 
 
 def visibility_region_reference(grid: OccupancyGrid, pose: Pose, camera: Camera) -> np.ndarray:
@@ -268,19 +285,7 @@ class VisibilityRegion:
         rows[1] and cols[0] <= col <= cols[1], and False or equal to it elsewhere."""
         if self._mask is not None:
             return self._mask
-        grid, pose, camera = self.grid, self.pose, self.camera
-        angles, distances, first = _ray_tables(camera)
-        i0, i1, samples = _rays_reaching(
-            angles, camera.angle_step, camera.distance_step, distances.size,
-            float(pose.x), float(pose.y), float(pose.theta), *grid.origin, float(grid.resolution),
-            rows[0], rows[1], cols[0], cols[1],
-        )
-        mask = np.zeros(grid.blocked.shape, dtype=bool)
-        if i1 > i0 and samples > first:
-            towards = pose.theta + angles[i0:i1]
-            _march(grid.blocked, np.cos(towards), np.sin(towards), distances[:samples], first,
-                   float(pose.x), float(pose.y), grid_frame(grid), mask)
-        return mask
+        return _mask_over(*self._kernel_arguments(), rows[0], rows[1], cols[0], cols[1])
 
     def holds(self, cells: np.ndarray) -> np.ndarray:
         """Bool (N,): whether the region holds each of the flat cell indices ``cells`` (N,)
@@ -288,20 +293,53 @@ class VisibilityRegion:
 
         Cells that cannot meet the field of view (their centres farther than half a cell
         diagonal from its wedge) are not in the region; the rays are cast only towards the
-        block of the others (:meth:`mask_over`).
+        block of the others (:meth:`mask_over`), all in one kernel.
         """
         cells = np.asarray(cells, dtype=np.int64)
         if self._mask is not None:
             return _lookup(self._mask.ravel(), cells, np.ones(cells.size, dtype=np.bool_))
+        return _holds(cells, *self._kernel_arguments())
+
+    def _kernel_arguments(self) -> tuple:
+        """The grid, pose and camera as :func:`_mask_over` and :func:`_holds` take them."""
         grid, pose, camera = self.grid, self.pose, self.camera
-        ox, oy, yaw = grid.origin
-        near_wedge, (r0, r1, c0, c1) = _near_wedge(
-            cells, grid.width, float(pose.x), float(pose.y), float(pose.theta), ox, oy, yaw,
-            float(grid.resolution), camera.fov, camera.far,
+        angles, distances, first = _ray_tables(camera)
+        return (
+            grid.blocked, grid_frame(grid), float(grid.origin[2]), float(pose.x), float(pose.y),
+            float(pose.theta), angles, distances, first, camera.angle_step, camera.distance_step,
+            camera.fov, camera.far,
         )
-        if r1 < r0:
-            return near_wedge  # all False
-        return _lookup(self.mask_over((r0, r1), (c0, c1)).ravel(), cells, near_wedge)
+
+
+@njit(cache=True)
+def _mask_over(blocked, frame, yaw, px, py, theta, angles, distances, first, angle_step,
+               distance_step, fov, far, row0, row1, col0, col1):
+    """Kernel of :meth:`VisibilityRegion.mask_over`: march the rays reaching the block."""
+    ox, oy, _, _, _, resolution = frame
+    i0, i1, samples = _rays_reaching(
+        angles, angle_step, distance_step, distances.size, px, py, theta, ox, oy, yaw,
+        resolution, row0, row1, col0, col1,
+    )
+    mask = np.zeros(blocked.shape, dtype=np.bool_)
+    if i1 > i0 and samples > first:
+        cos_a, sin_a = _directions(theta, angles, i0, i1)
+        _march(blocked, cos_a, sin_a, distances[:samples], first, px, py, frame, mask)
+    return mask
+
+
+@njit(cache=True)
+def _holds(cells, blocked, frame, yaw, px, py, theta, angles, distances, first, angle_step,
+           distance_step, fov, far):
+    """Kernel of :meth:`VisibilityRegion.holds` for a region not yet computed whole."""
+    ox, oy, _, _, _, resolution = frame
+    near, (r0, r1, c0, c1) = _near_wedge(
+        cells, blocked.shape[1], px, py, theta, ox, oy, yaw, resolution, fov, far
+    )
+    if r1 < r0:
+        return near  # all False
+    mask = _mask_over(blocked, frame, yaw, px, py, theta, angles, distances, first,
+                      angle_step, distance_step, fov, far, r0, r1, c0, c1)
+    return _lookup(mask.ravel(), cells, near)
 
 
 @njit(cache=True, inline="always")
