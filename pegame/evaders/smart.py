@@ -73,6 +73,7 @@ from __future__ import annotations
 
 import logging
 import math
+import weakref
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -259,6 +260,10 @@ def _sample_positions(skipped, count, step):
 # ------------------------------------------------------------------ candidate cells
 
 
+#: the components built so far, by planner (shared per map and radius) and candidate stride
+_COMPONENTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 @dataclass(frozen=True, eq=False)
 class _Component:
     """The candidate cells (on the candidate stride) of one connected component.
@@ -432,20 +437,31 @@ class SmartEvader(Evader):
         return escape_costs(effort, dist)
 
     def _component_at(self, me: Pose) -> _Component:
-        """The candidate cells of the evader's connected component, rebuilt only when the
-        cell the planner starts from (the evader's, or the nearest traversable one) lies
-        outside the cached one: components are disjoint."""
-        cached, grid = self._component, self.context.grid
-        if cached is not None:
-            # A cell of the cached component is traversable, so it is the start cell itself.
-            row, col = grid.world_to_cell(me.x, me.y)
-            if 0 <= row < grid.height and 0 <= col < grid.width and cached.mask[row, col]:
-                return cached
-            source = self.planner.nearest_traversable((me.x, me.y))
-            if source is not None and cached.mask[grid.world_to_cell(*source)]:
-                return cached
+        """The candidate cells of the evader's connected component: the one last used when
+        the cell the planner starts from (the evader's, or the nearest traversable one)
+        lies in it, else one built for an earlier game on this map (components are
+        disjoint, and shared by every evader with the same planner and candidate stride),
+        else a new one."""
+        grid = self.context.grid
+        shared = _COMPONENTS.setdefault(self.planner, {}).setdefault(self.config.candidate_stride, [])
+        row, col = grid.world_to_cell(me.x, me.y)
+        on_grid = 0 <= row < grid.height and 0 <= col < grid.width
+        source = None
+        for component in [self._component, *shared]:
+            if component is None:
+                continue
+            # A cell of a component is traversable, so it is the start cell itself.
+            if on_grid and component.mask[row, col]:
+                self._component = component
+                return component
+            if source is None:
+                source = self.planner.nearest_traversable((me.x, me.y))
+            if source is not None and component.mask[grid.world_to_cell(*source)]:
+                self._component = component
+                return component
         reachable = self.planner.reachable((me.x, me.y))
         self._component = _Component.build(reachable, self._strided, self._centres)
+        shared.append(self._component)
         return self._component
 
     def _exposed(self, visible: np.ndarray) -> tuple[np.ndarray, int, int]:
