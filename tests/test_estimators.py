@@ -23,6 +23,7 @@ from pegame.estimators.particle_filter import (
     ParticleFilter,
     _invert,
     _invert_reference,
+    _systematic,
     _wrap_angle,
     resample,
     wrap,
@@ -385,6 +386,24 @@ def test_inversion_kernel_matches_searchsorted():
         for positions in (sorted_positions, rng.random(m), edges):
             np.testing.assert_array_equal(
                 _invert(weights, positions), _invert_reference(weights, positions)
+            )
+
+
+def test_systematic_kernel_matches_searchsorted():
+    rng = np.random.default_rng(31)
+    for trial in range(400):
+        n = int(rng.integers(1, 500))
+        weights = rng.random(n) ** rng.uniform(0.5, 8.0)
+        weights[rng.random(n) < 0.3] = 0.0  # zero weights, leading and trailing too
+        if trial % 5 == 0:
+            weights = np.ones(n)  # cumulative weights i / n: positions land on them
+        if weights.sum() == 0.0:
+            weights[rng.integers(n)] = 1.0
+        weights /= weights.sum()
+        for offset in (rng.random(), 0.0, np.nextafter(1.0, 0.0), 0.5):
+            positions = (offset + np.arange(n)) / n
+            np.testing.assert_array_equal(
+                _systematic(weights, offset), _invert_reference(weights, positions)
             )
 
 

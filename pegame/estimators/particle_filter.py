@@ -108,6 +108,8 @@ def resample(
             return kept
         return np.concatenate([kept, invert(n * w - copies, rng.random(rest))])
     if scheme == "systematic":
+        if not reference:
+            return _systematic(w, rng.random())
         positions = (rng.random() + np.arange(n)) / n
     elif scheme == "stratified":
         positions = (rng.random(n) + np.arange(n)) / n
@@ -148,6 +150,46 @@ def _invert(weights, positions):
         # position exactly 1, and the search then returns N: such positions belong to the
         # last particle of positive weight (never to a trailing zero-weight one).
         indices[k] = min(found, last)
+    return indices
+
+
+@njit(cache=True)
+def _systematic(weights, offset):
+    """:func:`_invert` of the systematic positions (offset + k) / N, k = 0..N-1, for the
+    N ``weights`` and ``offset`` in [0, 1): the same indices, without a search.
+
+    Particle i takes the positions below its normalised cumulative weight C_i and not
+    below C_(i-1); there are c_i = ceil(N C_i - offset) positions below C_i (checked
+    against the positions themselves, computed as numpy computes them, so round-off
+    cannot shift one). Position k's index is then the number of particles with c_i <= k,
+    a running count over k: no branch depends on the weights, about twice as fast as the
+    search on a real filter's weights.
+    """
+    n = weights.size
+    cumulative = np.empty(n)
+    running = 0.0
+    for i in range(n):
+        running += weights[i]
+        cumulative[i] = running
+    cumulative /= cumulative[-1]
+    last = n - 1
+    while weights[last] == 0.0:
+        last -= 1
+    ending = np.zeros(n + 1, dtype=np.int64)  # ending[c]: particles with c_i == c
+    for i in range(n):
+        below = min(max(math.ceil(cumulative[i] * n - offset), 0), n)
+        while below > 0 and (offset + (below - 1)) / n >= cumulative[i]:
+            below -= 1
+        while below < n and (offset + below) / n < cumulative[i]:
+            below += 1
+        ending[below] += 1
+    indices = np.empty(n, dtype=np.int64)
+    passed = 0
+    for k in range(n):
+        passed += ending[k]
+        # As in _invert, a position that round-off puts past the last positive weight
+        # belongs to that particle.
+        indices[k] = min(passed, last)
     return indices
 
 
