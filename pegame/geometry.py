@@ -185,25 +185,38 @@ def _ray_cells(px, py, ray, distances, frame, shape, divide, cells):
 
 @njit(cache=True)
 def _march(blocked, cos_a, sin_a, distances, first, px, py, frame, mask):
-    """Mark in ``mask`` the cells seen along each ray, stopping at the first blocked one.
+    """Mark in ``mask`` the cells seen along each ray, stopping at the first blocked one,
+    and return the bounds (r0, r1, c0, c1) of the marked cells: rows [r0, r1) and columns
+    [c0, c1) (r1 <= r0 when none).
 
-    Ray directions come precomputed by numpy and cells follow ``OccupancyGrid.world_to_cell``
-    exactly (:func:`_ray_cells`), so the result matches :func:`visibility_region_reference`
-    bit for bit. Each ray's cells are computed in one branch-free pass before the walk
-    along it, which is faster than stopping the computation at the first blocked sample.
+    Ray directions come from :func:`_directions` and cells follow
+    ``OccupancyGrid.world_to_cell`` exactly (:func:`_ray_cells`), so the result matches
+    :func:`visibility_region_reference` bit for bit. Each ray's cells are computed in one
+    branch-free pass before the walk along it, which is faster than stopping the
+    computation at the first blocked sample. A ray's cells move monotonically in row and
+    column, so its first and last marked cells bound all of its marked cells.
     """
     blocked_flat, mask_flat = blocked.ravel(), mask.ravel()
+    width = blocked.shape[1]
+    r0, r1, c0, c1 = blocked.shape[0], 0, width, 0
     cells = np.empty(distances.size, dtype=np.int64)
     for i in range(cos_a.size):
         ray = (cos_a[i], sin_a[i])
         if not _ray_cells(px, py, ray, distances, frame, blocked.shape, False, cells):
             _ray_cells(px, py, ray, distances, frame, blocked.shape, True, cells)
+        stop = distances.size
         for j in range(distances.size):
             cell = cells[j]
             if cell < 0 or blocked_flat[cell]:
+                stop = j
                 break
             if j >= first:
                 mask_flat[cell] = True
+        if stop > first:
+            for end in (cells[first], cells[stop - 1]):
+                row, col = end // width, end % width
+                r0, r1, c0, c1 = min(r0, row), max(r1, row + 1), min(c0, col), max(c1, col + 1)
+    return r0, r1, c0, c1
 
 
 @njit(cache=True)
@@ -233,18 +246,25 @@ def visibility_region(grid: OccupancyGrid, pose: Pose, camera: Camera) -> np.nda
     ``camera.near`` m before the first blocked or off-grid sample are True. Blocked cells
     are never True; a camera in a blocked cell gives an all-False mask.
     """
+    return _whole_region(grid, pose, camera)[0]
+
+
+def _whole_region(grid: OccupancyGrid, pose: Pose, camera: Camera):
+    """:func:`visibility_region`'s mask and the bounds (r0, r1, c0, c1) of its True
+    cells, rows [r0, r1) and columns [c0, c1) (r1 <= r0 when there is none)."""
     _, distances, first = _ray_tables(camera)
     cos_a, sin_a = _ray_directions(pose, camera)
     mask = np.zeros(grid.blocked.shape, dtype=bool)
     px, py = float(pose.x), float(pose.y)
-    _march(grid.blocked, cos_a, sin_a, distances, first, px, py, grid_frame(grid), mask)
-    return mask
+    bounds = _march(grid.blocked, cos_a, sin_a, distances, first, px, py, grid_frame(grid), mask)
+    return mask, bounds
 
 
 class VisibilityRegion:
     """The visibility region V^p_k of the camera at one pose, computed on demand.
 
-    :attr:`mask` is the whole region of :func:`visibility_region`, computed once. Most
+    :attr:`mask` is the whole region of :func:`visibility_region`, computed once, and
+    :attr:`bounds` the block of cells that holds it. Most
     consumers need only part of it: the particle filter asks about its particles' cells
     (:meth:`holds`), which usually lie in a small block of the grid. :meth:`mask_over`
     marches only the rays that can reach a given block of cells, and only as far as the
@@ -256,6 +276,7 @@ class VisibilityRegion:
     def __init__(self, grid: OccupancyGrid, pose: Pose, camera: Camera) -> None:
         self.grid, self.pose, self.camera = grid, pose, camera
         self._mask: np.ndarray | None = None
+        self._bounds: tuple[int, int, int, int] | None = None
 
     @classmethod
     def given(cls, mask: np.ndarray) -> VisibilityRegion:
@@ -265,6 +286,8 @@ class VisibilityRegion:
         region.grid = region.pose = region.camera = None
         region._mask = np.asarray(mask, dtype=bool).view()
         region._mask.setflags(write=False)
+        rows, cols = np.flatnonzero(region._mask.any(axis=1)), np.flatnonzero(region._mask.any(axis=0))
+        region._bounds = (rows[0], rows[-1] + 1, cols[0], cols[-1] + 1) if rows.size else (0, 0, 0, 0)
         return region
 
     @property
@@ -276,9 +299,16 @@ class VisibilityRegion:
     def mask(self) -> np.ndarray:
         """The whole region: bool (H, W) over the grid, read-only."""
         if self._mask is None:
-            self._mask = visibility_region(self.grid, self.pose, self.camera)
+            self._mask, self._bounds = _whole_region(self.grid, self.pose, self.camera)
             self._mask.setflags(write=False)
         return self._mask
+
+    @property
+    def bounds(self) -> tuple[int, int, int, int]:
+        """(r0, r1, c0, c1): rows [r0, r1) and columns [c0, c1) hold every cell of
+        :attr:`mask` (r1 <= r0 when it is empty); found while the mask is computed."""
+        self.mask  # noqa: B018 - computes the bounds with the mask
+        return self._bounds
 
     def mask_over(self, rows: tuple[int, int], cols: tuple[int, int]) -> np.ndarray:
         """A bool (H, W) mask equal to :attr:`mask` on the cells with rows[0] <= row <=

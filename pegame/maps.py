@@ -101,6 +101,13 @@ class OccupancyGrid:
         Works on scalars or arrays; results may lie outside the grid (see ``contains``).
         """
         ox, oy, yaw = self.origin
+        if isinstance(x, (float, int)) and isinstance(y, (float, int)) and math.isfinite(x + y):
+            # The same float operations as below, without numpy's per-call overhead.
+            dx, dy = float(x) - ox, float(y) - oy
+            if yaw:
+                c, s = math.cos(yaw), math.sin(yaw)
+                dx, dy = c * dx + s * dy, -s * dx + c * dy
+            return math.floor(dy / self.resolution), math.floor(dx / self.resolution)
         dx = np.asarray(x, dtype=float) - ox
         dy = np.asarray(y, dtype=float) - oy
         if yaw:

@@ -204,6 +204,23 @@ def test_region_holds_exactly_the_mask_cells_asked_about(seed):
     assert skipped == 40  # the whole mask was never needed
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_region_bounds_hold_exactly_its_cells(seed):
+    rng = np.random.default_rng(900 + seed)
+    yaw = 0.0 if seed % 2 else 0.7
+    grid = random_grid(rng, 50, 70, 0.05, (rng.uniform(-2, 2), rng.uniform(-2, 2), yaw))
+    empty = 0
+    for _ in range(40):
+        region = VisibilityRegion(grid, random_free_pose(rng, grid), random_camera(rng))
+        rows, cols = np.nonzero(region.mask)
+        expected = (rows.min(), rows.max() + 1, cols.min(), cols.max() + 1) if rows.size else None
+        r0, r1, c0, c1 = region.bounds
+        assert (r0, r1, c0, c1) == expected if rows.size else r1 <= r0
+        assert VisibilityRegion.given(region.mask).bounds == (expected or (0, 0, 0, 0))
+        empty += rows.size == 0
+    assert empty < 40
+
+
 def test_region_mask_is_computed_once_and_read_only():
     grid = random_grid(np.random.default_rng(5), 40, 40, 0.1)
     region = VisibilityRegion(grid, Pose(2.0, 2.0, 0.3), CAMERA)

@@ -373,3 +373,15 @@ def test_paper_map_free_standing_obstacles(paper_map):
     near_outside = ndimage.binary_dilation(paper_map.data == -1, np.ones((3, 3)))
     outer_walls = np.count_nonzero(np.unique(labels[near_outside]))
     assert n - outer_walls == expected
+
+
+@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-3.2, 1.7, 0.0), (1.1, -0.4, 0.9)])
+def test_world_to_cell_of_scalars_equals_that_of_arrays(origin):
+    grid = OccupancyGrid(np.zeros((20, 30), dtype=np.int8), 0.05, origin)
+    rng = np.random.default_rng(3)
+    xs, ys = rng.uniform(-5, 5, 2000), rng.uniform(-5, 5, 2000)
+    xs[:100], ys[:100] = np.round(xs[:100] / 0.05) * 0.05, np.round(ys[:100] / 0.05) * 0.05  # edges
+    rows, cols = grid.world_to_cell(xs, ys)
+    scalar = [grid.world_to_cell(float(x), float(y)) for x, y in zip(xs, ys)]
+    assert scalar == list(zip(rows.tolist(), cols.tolist()))
+    assert all(type(v) is int for v in scalar[0])

@@ -83,7 +83,7 @@ from scipy.ndimage import distance_transform_edt
 
 from pegame.api import STOP, Evader, EvaderObservation, Plan, Pose, Velocity
 from pegame.errors import require
-from pegame.geometry import visibility_region
+from pegame.geometry import VisibilityRegion, visibility_region
 from pegame.navigation import PathFollower, Planner
 
 log = logging.getLogger(__name__)
@@ -384,7 +384,7 @@ class SmartEvader(Evader):
         """Algorithm 2's argmin for the evader at ``me`` and the pursuer at ``pursuer``:
         the same result as :meth:`escape_reference`, by the kernels (module docstring)."""
         grid = self.context.grid
-        visible = visibility_region(grid, pursuer, self.context.camera)
+        visible = VisibilityRegion(grid, pursuer, self.context.camera)
         component = self._component_at(me)
         exposed, top, left = self._exposed(visible)
         skipped = _exposed_positions(exposed, top, left, grid.width, component.position)
@@ -464,14 +464,13 @@ class SmartEvader(Evader):
         shared.append(self._component)
         return self._component
 
-    def _exposed(self, visible: np.ndarray) -> tuple[np.ndarray, int, int]:
+    def _exposed(self, visible: VisibilityRegion) -> tuple[np.ndarray, int, int]:
         """V grown by the hide margin (no candidate lies there) over a window: a bool
         mask, its top row and its left column."""
-        rows = np.flatnonzero(visible.any(axis=1))
-        if rows.size == 0:
+        r0, r1, c0, c1 = visible.bounds
+        if r1 <= r0:
             return np.zeros((0, 0), dtype=bool), 0, 0
-        cols = np.flatnonzero(visible.any(axis=0))
-        return _grow(visible, rows[0], rows[-1] + 1, cols[0], cols[-1] + 1, self._half_widths)
+        return _grow(visible.mask, r0, r1, c0, c1, self._half_widths)
 
     def _bounds(self, component: _Component, me: Pose, pursuer: Pose):
         """Per-tile cost lower bounds (T,) and, for geodesic distances, the flat effort and
