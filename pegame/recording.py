@@ -20,8 +20,10 @@ world/map                  GridMap of the occupancy grid: cell size = resolution
                            lower-left corner at the map origin (static)
 world/pursuer/pose         Points3D, a ball of the body radius          every tick
 world/pursuer/heading      Arrows3D                                     every tick
-world/pursuer/trajectory   LineStrips3D, positions so far, one every ``trail_every``
-                           ticks; logged at those ticks and at the last one
+world/pursuer/trajectory   LineStrips3D, the segment from the previous trajectory point
+                           to the position, every ``trail_every`` ticks and at the
+                           last one; the map view shows every segment up to the time
+                           cursor (a visible time range on this entity)
 world/pursuer/fov          LineStrips3D, ``geometry.fov_wedge`` at the zero pose (static),
                            placed by a Transform3D                      every tick
 world/pursuer/visible      LineStrips3D, outline of the visibility region every tick
@@ -120,7 +122,7 @@ class RerunRecorder(Recorder):
         flush_every: int = 1000  # control ticks buffered per send (sends cost a fixed time each; a 90 s game is one)
         live_flush_every: int = 10  # the same with spawn=true, so that the live viewer keeps up
         max_particles: int = 100  # particles logged per tick, an evenly strided subsample (0: none)
-        trail_every: int = 5  # control ticks between trajectory points (and re-logs of the trajectories)
+        trail_every: int = 5  # control ticks between trajectory points
         outline_rays: int = 64  # rays cast on the grid to draw the visibility region's outline
         image_every: int = 10  # control ticks between logged camera images (0: none)
         jpeg_quality: int = 80  # JPEG quality (1-100) of the logged camera images
@@ -145,7 +147,7 @@ class RerunRecorder(Recorder):
         # particles: per tick with any, (step, time), the (k, 2) positions and uint8 shades
         self._particles = _ParticleRows(self._flush_every, config.max_particles)
         self._buffers: dict[str, _Buffer] = {}
-        self._trails = {name: _Trail(Z_TRAIL) for name in ("pursuer", "evader")}
+        self._trail_ends: dict[str, np.ndarray] = {}  # per agent, the last trajectory point (1, 3)
         self._plans: list = [None, None]
         self._modes: dict[str, Any] = {"pursuer": None, "evader": None}
         self._detected: bool | None = None
@@ -226,12 +228,10 @@ class RerunRecorder(Recorder):
         import rerun as rr
 
         if self._last is not None:
-            if self._last.step % self.config.trail_every:
-                self._log_trails(self._last)
             rate = result.get("tracking_rate")
             text = "game over" + (f": tracking rate {100 * rate:.1f}%" if rate is not None else "")
             self._add("events", rr.TextLog, self._last, text=[text], level=["INFO"])
-        self._flush()
+        self._flush(final=True)
         _send_property(self._rec, "result", flat_config(result))
         # Closing the file sink waits for its writer: a write error (full disk) raises here.
         self._rec.disconnect()
@@ -263,23 +263,12 @@ class RerunRecorder(Recorder):
         self._last = tick
         self._detections += tick.detection is not None
         self._rows.append(_row(tick, self._detections / (tick.step + 1)))
-        if tick.step % self.config.trail_every == 0:
-            self._log_trails(tick)
         self._log_particles(tick)
         self._log_plans(tick)
         self._log_events(tick)
         self._log_image(tick)
         if (tick.step + 1) % self._flush_every == 0:
             self._flush()
-
-    def _log_trails(self, tick: Tick) -> None:
-        """Both trajectories so far, through this tick's positions. Logged every
-        ``trail_every`` ticks only: the gap to the agent stays under its disc."""
-        import rerun as rr
-
-        for name, pose in (("pursuer", tick.pursuer), ("evader", tick.evader)):
-            strip = self._trails[name].append(pose.x, pose.y)
-            self._add(f"world/{name}/trajectory", rr.LineStrips3D, tick, strips=[strip])
 
     def _add(self, path: str, kind: type, tick: Tick, create: bool = True, **values) -> None:
         """Buffer one row of ``kind`` at ``path``; with create=False only for an entity
@@ -359,14 +348,16 @@ class RerunRecorder(Recorder):
 
     # ----------------------------------------------------------------------- flush
 
-    def _flush(self) -> None:
-        """Send the buffered rows and buffers. The file is written by rerun-sdk's own
-        thread meanwhile; a write error surfaces when ``finish`` waits for it."""
+    def _flush(self, final: bool = False) -> None:
+        """Send the buffered rows and buffers (``final``: the game's last ones). The file
+        is written by rerun-sdk's own thread meanwhile; a write error surfaces when
+        ``finish`` waits for it."""
         indexes: dict = {}
         if self._rows:
             columns = dict(zip(ROW, np.array(self._rows, dtype=float).T))
             self._rows = []
             self._send_rows(columns, indexes)
+            self._send_trails(columns, indexes, final)
         self._send_particles(indexes)
         for buffer in self._buffers.values():
             buffer.send(self._rec, indexes)
@@ -414,6 +405,26 @@ class RerunRecorder(Recorder):
         outlines = visibility_outlines(ctx.grid, c["px"], c["py"], c["ptheta"], ctx.camera,
                                        self.config.outline_rays, Z_REGION)
         self._send("world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips_array(outlines)))
+
+    def _send_trails(self, c: dict[str, np.ndarray], indexes: dict, final: bool) -> None:
+        """Both trajectories as segments, each from the previous trajectory point to the
+        agent's position, every ``trail_every`` ticks and at the last tick (``final``):
+        the gap to the agent stays under its disc, and the data grows linearly with the
+        game, where re-logging the whole trajectory would grow quadratically."""
+        import rerun as rr
+
+        steps = c["step"].astype(np.int64)
+        picked = steps % self.config.trail_every == 0
+        picked[-1] |= final
+        if not picked.any():
+            return
+        index = _index(indexes, steps[picked], c["time"][picked])
+        for name, prefix in (("pursuer", "p"), ("evader", "e")):
+            ends = _stack(c[f"{prefix}x"][picked], c[f"{prefix}y"][picked], Z_TRAIL)
+            starts = np.concatenate([self._trail_ends.get(name, ends[:1]), ends[:-1]])
+            self._trail_ends[name] = ends[-1:]
+            segments = strips_array(np.stack([starts, ends], axis=1))
+            self._send(f"world/{name}/trajectory", index, rr.LineStrips3D.columns(strips=segments))
 
     def _send_sensing(self, c: dict[str, np.ndarray], every: list) -> None:
         """Detection (map point and image box) and estimate; an empty row where there is none."""
@@ -603,22 +614,6 @@ class _ParticleRows:
         kept = np.flatnonzero(held)  # take() copies rows several times faster than a bool mask
         positions = np.take(self.xyz[:n].reshape(-1, 3), kept, axis=0)
         return self.steps[:n].copy(), self.times[:n].copy(), positions, shades.ravel()[kept], sizes
-
-
-class _Trail:
-    """An agent's positions so far (map frame, m) at height z (m), as a growing array."""
-
-    def __init__(self, z: float) -> None:
-        self.points = np.full((256, 3), z, dtype=np.float32)
-        self.count = 0
-
-    def append(self, x: float, y: float) -> np.ndarray:
-        """Add (x, y); return a (K, 3) float32 copy of the trail."""
-        if self.count == len(self.points):
-            self.points = np.concatenate([self.points, self.points])
-        self.points[self.count, :2] = (x, y)
-        self.count += 1
-        return self.points[: self.count].copy()
 
 
 def _stack(x: np.ndarray, y: np.ndarray, z) -> np.ndarray:
@@ -852,8 +847,15 @@ def blueprint(grid, camera, has_image: bool):
     # An eye slightly south of the zenith keeps +y up on screen while orbiting stays about z.
     eye = rrb.EyeControls3D(kind=rrb.Eye3DKind.Orbital, position=[cx, cy - 0.02 * height, height],
                             look_target=[cx, cy, 0.0], eye_up=[0.0, 0.0, 1.0])
+    # Trajectories are logged as segments: the view shows all of them up to the cursor.
+    so_far = rrb.VisibleTimeRanges([
+        rrb.VisibleTimeRange(timeline, start=rrb.TimeRangeBoundary.infinite(),
+                             end=rrb.TimeRangeBoundary.cursor_relative())
+        for timeline in (STEP, SIM_TIME)
+    ])
+    trails = {f"world/{name}/trajectory": so_far for name in ("pursuer", "evader")}
     map_view = rrb.Spatial3DView(origin="world", name="Map", eye_controls=eye,
-                                 line_grid=rrb.LineGrid3D(visible=False))
+                                 line_grid=rrb.LineGrid3D(visible=False), overrides=trails)
     side = [
         rrb.TimeSeriesView(origin="plots/tracking", name="Tracking", axis_y=rrb.ScalarAxis(range=(0.0, 1.05))),
         rrb.TimeSeriesView(origin="plots/distance", name="Distances (m)"),
