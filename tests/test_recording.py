@@ -135,6 +135,27 @@ def test_fov_wedge_is_placed_at_the_pursuer_pose_every_step(played):
         np.testing.assert_allclose(placed, fov_wedge(game.camera, pose, n=16), atol=1e-5)
 
 
+def test_trajectories_are_chained_segments_through_the_agent_poses(played):
+    from rerun.chunk import RrdReader
+
+    _, outcome, out_dir = played
+    poses = {row[0]: {"pursuer": row[2:4], "evader": row[5:7]} for row in outcome.trajectory}
+    for name in ("pursuer", "evader"):
+        segments = {}
+        for chunk in RrdReader(out_dir / "game.rrd").stream().to_chunks():
+            if chunk.entity_path == f"/world/{name}/trajectory" and not chunk.is_static:  # static: style
+                batch = chunk.to_record_batch()
+                for step, strips in zip(batch.column("step").to_pylist(),
+                                        batch.column("LineStrips3D:strips").to_pylist()):
+                    segments[step] = np.array(strips[0])
+        steps = sorted(segments)
+        assert steps == [*range(0, TICKS, 5), TICKS - 1]
+        for previous, step in zip([steps[0], *steps], steps):
+            start, end = segments[step]
+            np.testing.assert_allclose(end[:2], poses[step][name], atol=1e-5)
+            np.testing.assert_allclose(start[:2], poses[previous][name], atol=1e-5)
+
+
 def test_recording_does_not_change_the_game(played, compose_config, tmp_path):
     _, outcome, _ = played
     plain = Game(compose_config(["recorder=none", *SHORT])).play(tmp_path)
