@@ -298,17 +298,21 @@ class VisibilityRegion:
     @property
     def mask(self) -> np.ndarray:
         """The whole region: bool (H, W) over the grid, read-only."""
-        if self._mask is None:
-            self._mask, self._bounds = _whole_region(self.grid, self.pose, self.camera)
-            self._mask.setflags(write=False)
+        self._compute_whole()
         return self._mask
 
     @property
     def bounds(self) -> tuple[int, int, int, int]:
         """(r0, r1, c0, c1): rows [r0, r1) and columns [c0, c1) hold every cell of
         :attr:`mask` (r1 <= r0 when it is empty); found while the mask is computed."""
-        self.mask  # noqa: B018 - computes the bounds with the mask
+        self._compute_whole()
         return self._bounds
+
+    def _compute_whole(self) -> None:
+        """Compute :attr:`mask` and :attr:`bounds`, once."""
+        if self._mask is None:
+            self._mask, self._bounds = _whole_region(self.grid, self.pose, self.camera)
+            self._mask.setflags(write=False)
 
     def mask_over(self, rows: tuple[int, int], cols: tuple[int, int]) -> np.ndarray:
         """A bool (H, W) mask equal to :attr:`mask` on the cells with rows[0] <= row <=
