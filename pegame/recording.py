@@ -889,11 +889,14 @@ def recording_name(game_id: str, properties: dict[str, Any]) -> str:
 
 
 def _send_property(rec, name: str, values: dict[str, Any]) -> None:
-    """A recording property of flat {key: value} pairs (none: nothing to send)."""
+    """A recording property of flat {key: value} pairs (none: nothing to send). The values
+    go in as one-element Arrow arrays: the same column types as rerun-sdk infers, without
+    its per-value inference (half the time)."""
+    import pyarrow as pa
     import rerun as rr
 
     if values:
-        rec.send_property(name, rr.AnyValues(**values))
+        rec.send_property(name, rr.AnyValues(**{key: pa.array([value]) for key, value in values.items()}))
 
 
 def flat_config(tree: dict[str, Any], prefix: str = "") -> dict[str, Any]:

@@ -156,6 +156,23 @@ def test_trajectories_are_chained_segments_through_the_agent_poses(played):
             np.testing.assert_allclose(start[:2], poses[previous][name], atol=1e-5)
 
 
+def test_config_and_result_are_recording_properties_with_their_types(played):
+    from rerun.chunk import RrdReader
+
+    game, outcome, out_dir = played
+    found = {}
+    for chunk in RrdReader(out_dir / "game.rrd").stream().to_chunks():
+        if chunk.entity_path in ("/__properties/config", "/__properties/result"):
+            batch = chunk.to_record_batch()
+            found.update({(chunk.entity_path, name): batch.column(name).to_pylist()[0][0]
+                          for name in batch.schema.names if name != "rerun.controls.RowId"})
+    assert found[("/__properties/config", "game.seed")] == game.config["game"]["seed"]
+    assert found[("/__properties/config", "camera.fov")] == pytest.approx(game.camera.fov)
+    assert found[("/__properties/result", "pairing")] == outcome.result["pairing"]
+    assert found[("/__properties/result", "tracking_rate")] == outcome.result["tracking_rate"]
+    assert type(found[("/__properties/config", "game.seed")]) is int
+
+
 def test_recording_does_not_change_the_game(played, compose_config, tmp_path):
     _, outcome, _ = played
     plain = Game(compose_config(["recorder=none", *SHORT])).play(tmp_path)
