@@ -372,6 +372,20 @@ def test_update_kernels_match_the_reference_when_the_weights_vanish():
         assert_same_belief(fast, slow)
 
 
+def test_motion_kernel_matches_the_reference_beyond_the_polynomial_range():
+    # Headings past pegame.trig's range take libm's sine and cosine in the kernel.
+    grid = room()
+    fast = build(ParticleFilter, grid, seed=5, n_particles=400)
+    slow = build(ParticleFilter, grid, seed=5, n_particles=400)
+    start = detection(2.0, 2.0)
+    view = disc(grid, start.position, 1.0)
+    fast.reset(PURSUER, start, view)
+    slow.reset(PURSUER, start, view)
+    headings = np.where(np.arange(400) % 2, 1e7, -3e9) + fast.particles[:, 2]
+    fast.particles = slow.particles = np.column_stack([fast.particles[:, :2], headings])
+    assert_same_belief(fast.update(DT, PURSUER, start, view), slow.update_reference(DT, PURSUER, start, view))
+
+
 def test_inversion_kernel_matches_searchsorted():
     rng = np.random.default_rng(29)
     for trial in range(300):

@@ -433,3 +433,13 @@ def test_fov_wedge_is_a_closed_ring_on_the_range_limits(near):
     assert np.allclose(dist[: 16 if near else 1], near)
     bearing = np.arctan2(d[-17:-1, 1], d[-17:-1, 0]) - pose.theta
     assert np.allclose([bearing.min(), bearing.max()], [-0.6, 0.6])
+
+
+def test_ray_directions_are_libm_s_beyond_the_polynomial_range():
+    from pegame.geometry import _directions
+
+    angles = np.linspace(-0.5, 0.5, 101)
+    for theta in (0.3, -2.9, 1e7, -4e9):
+        cos_a, sin_a = _directions(theta, angles, 10, 90)
+        np.testing.assert_allclose(cos_a, np.cos(theta + angles[10:90]), rtol=0, atol=2.3e-16)
+        np.testing.assert_allclose(sin_a, np.sin(theta + angles[10:90]), rtol=0, atol=2.3e-16)
