@@ -494,12 +494,11 @@ class _Buffer:
 
     A row is one tick's step and time and, per component, one value per instance: a
     numeric array of shape (n, ...), a list of n strings, or (for ``strips``) a list of
-    n (K, 3) arrays. ``prepare``, if given, turns the concatenated values into the
-    archetype's columns just before sending.
+    n (K, 3) arrays.
     """
 
-    def __init__(self, path: str, kind: type, prepare=None) -> None:
-        self.path, self.kind, self.prepare = path, kind, prepare
+    def __init__(self, path: str, kind: type) -> None:
+        self.path, self.kind = path, kind
         self.steps: list[int] = []
         self.times: list[float] = []
         self.sizes: list[int] = []
@@ -518,8 +517,6 @@ class _Buffer:
         if not self.steps:
             return
         columns = {key: _column(key, parts) for key, parts in self.values.items()}
-        if self.prepare is not None:
-            columns = self.prepare(**columns)
         index = _index(indexes, np.asarray(self.steps, dtype=np.int64), np.asarray(self.times))
         columns = self.kind.columns(**columns).partition(self.sizes)
         rec.send_columns(self.path, indexes=index, columns=columns, strict=True)
