@@ -286,8 +286,7 @@ class VisibilityRegion:
         region.grid = region.pose = region.camera = None
         region._mask = np.asarray(mask, dtype=bool).view()
         region._mask.setflags(write=False)
-        rows, cols = np.flatnonzero(region._mask.any(axis=1)), np.flatnonzero(region._mask.any(axis=0))
-        region._bounds = (rows[0], rows[-1] + 1, cols[0], cols[-1] + 1) if rows.size else (0, 0, 0, 0)
+        region._bounds = None  # found on demand
         return region
 
     @property
@@ -306,6 +305,9 @@ class VisibilityRegion:
         """(r0, r1, c0, c1): rows [r0, r1) and columns [c0, c1) hold every cell of
         :attr:`mask` (r1 <= r0 when it is empty); found while the mask is computed."""
         self._compute_whole()
+        if self._bounds is None:  # a given mask
+            rows, cols = np.flatnonzero(self._mask.any(axis=1)), np.flatnonzero(self._mask.any(axis=0))
+            self._bounds = (rows[0], rows[-1] + 1, cols[0], cols[-1] + 1) if rows.size else (0, 0, 0, 0)
         return self._bounds
 
     def _compute_whole(self) -> None:
