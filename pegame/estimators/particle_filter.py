@@ -37,16 +37,16 @@ issue #290). The tests compare these against filterpy's.
 
 Fast path. :meth:`ParticleFilter.update` runs the per-particle work in numba kernels:
 one moves the particles and finds their cells, one weighs them, normalises the weights
-and computes N_eff, one inverts the cumulative weights for resampling, one computes the
-mean and covariance. It asks V_k^p only about the cells its moved particles landed in
-(``VisibilityRegion.holds``), so the camera's rays are cast only towards those in its
-field of view, with the same answer as the whole mask. The motion draws come from the
-component's Generator, a batch of updates at a time, and both paths use the same draws.
-The plain numpy reference :meth:`ParticleFilter.update_reference` gives the same
-particles, weights, N_eff and moments to round-off (the tests hold it to 1e-12
-relative): the kernels sum in order where numpy sums pairwise, and take the headings'
-sines and cosines from a vectorised polynomial (:mod:`pegame.trig`, within 2^-52 of
-libm's), about four times faster.
+and computes N_eff, one inverts the cumulative weights for resampling (systematic
+positions by counting), one computes the mean and covariance. It asks V_k^p only about
+the cells its moved particles landed in (``VisibilityRegion.holds``), so the camera's
+rays are cast only towards those in its field of view, with the same answer as the whole
+mask. The motion draws come from the component's Generator, a batch of updates at a
+time, and both paths use the same draws. The plain numpy reference
+:meth:`ParticleFilter.update_reference` gives the same particles, weights, N_eff and
+moments to round-off (the tests hold it to 1e-12 relative): the kernels sum in order
+where numpy sums pairwise, and take the headings' sines and cosines from a vectorised
+polynomial (:mod:`pegame.trig`, within 2^-52 of libm's), about four times faster.
 """
 
 from __future__ import annotations
@@ -121,6 +121,23 @@ def resample(
 
 
 @njit(cache=True)
+def _cumulative(weights):
+    """(cumulative (N,), last): the cumulative sums of the non-negative ``weights`` (N,),
+    accumulated in order and normalised by their total, and the index of the last positive
+    weight."""
+    cumulative = np.empty(weights.size)
+    running = 0.0
+    for i in range(weights.size):
+        running += weights[i]
+        cumulative[i] = running
+    cumulative /= cumulative[-1]
+    last = weights.size - 1
+    while weights[last] == 0.0:
+        last -= 1
+    return cumulative, last
+
+
+@njit(cache=True)
 def _invert(weights, positions):
     """For each position in [0, 1), the index whose cumulative-weight interval holds it.
 
@@ -128,16 +145,7 @@ def _invert(weights, positions):
     accumulated in the same order, and each search returns the first index whose
     normalised cumulative weight exceeds the position, as searchsorted(side="right") does.
     """
-    n = weights.size
-    cumulative = np.empty(n)
-    running = 0.0
-    for i in range(n):
-        running += weights[i]
-        cumulative[i] = running
-    cumulative /= cumulative[-1]
-    last = n - 1
-    while weights[last] == 0.0:
-        last -= 1
+    cumulative, last = _cumulative(weights)
     indices = np.empty(positions.size, dtype=np.int64)
     found = 0
     for k in range(positions.size):
@@ -166,15 +174,7 @@ def _systematic(weights, offset):
     search on a real filter's weights.
     """
     n = weights.size
-    cumulative = np.empty(n)
-    running = 0.0
-    for i in range(n):
-        running += weights[i]
-        cumulative[i] = running
-    cumulative /= cumulative[-1]
-    last = n - 1
-    while weights[last] == 0.0:
-        last -= 1
+    cumulative, last = _cumulative(weights)
     ending = np.zeros(n + 1, dtype=np.int64)  # ending[c]: particles with c_i == c
     for i in range(n):
         below = min(max(math.ceil(cumulative[i] * n - offset), 0), n)
