@@ -305,14 +305,11 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
     return moved, cells
 
 
-#: fastmath flags that let LLVM vectorise sums (by reordering them) and fuse products, but
-#: keep NaN and infinity semantics (the weight checks rely on them)
-REORDER = {"reassoc", "nsz", "arcp", "contract"}
 #: exp(x) is subnormal (below 2.2e-308) or 0 for x below this
 SUBNORMAL_EXPONENT = -708.0
 
 
-@njit(cache=True, fastmath=REORDER)
+@njit(cache=True)
 def _exponents(moved, zx, zy, two_sigma2):
     """-|p_i - z|^2 / (2 sigma^2) per particle (N,): the log-likelihood of a detection at
     (zx, zy) (map frame, m); -inf where its exp would be subnormal or 0 (below
@@ -326,7 +323,7 @@ def _exponents(moved, zx, zy, two_sigma2):
     return out
 
 
-@njit(cache=True, fastmath=REORDER)
+@njit(cache=True)
 def _weigh(prior, cells, seen, likelihood, detected, seen_boost, miss_factor):
     """Measurement update of the weights (module docstring): (weights (N,), total,
     evidence, n_eff).
