@@ -25,11 +25,12 @@ from typing import Any, Callable
 import numpy as np
 
 from pegame import registry
-from pegame.api import Body, Camera, Context, EvaderObservation, Pose, PursuerObservation
+from pegame.api import Context, EvaderObservation, PursuerObservation
+from pegame.types import Body, Camera, Pose
 from pegame.config import compose, resolve_map_path
 from pegame.game import Game
-from pegame.geometry import VisibilityRegion, visibility_region
-from pegame.maps import OccupancyGrid, load_map
+from pegame.visibility import VisibilityRegion, visibility_region
+from pegame.grid import OccupancyGrid, load_map
 from pegame.navigation import Planner
 
 PAPER_MAPS = ("hall", "enclosed", "brick")
@@ -89,7 +90,7 @@ def bench_planner(grid: OccupancyGrid, repeat: int) -> tuple[float, float]:
 
 def bench_sim_steps(grid: OccupancyGrid, steps: int) -> float:
     """Grid-simulator control steps per second (both agents moving)."""
-    from pegame.api import Velocity
+    from pegame.types import Velocity
     from pegame.sims.grid import GridSimulator
 
     context = Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)

@@ -23,7 +23,7 @@ from hydra.plugins.search_path_plugin import SearchPathPlugin
 from omegaconf import MISSING, DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
-from pegame.api import Camera
+from pegame.types import Camera
 from pegame.errors import ConfigError, require
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from pegame.files import write_atomic
 from pegame.game import TRAJECTORY_HEADER
-from pegame.maps import OccupancyGrid
+from pegame.grid import OccupancyGrid
 
 PURSUER_COLOR = "#dc2828"
 EVADER_COLOR = "#1ea03c"

@@ -8,7 +8,7 @@ visibility region; at every decision tick (1 / ``game.decision_hz``) the evader 
 first, then the pursuer; both then act concurrently at control rate. The pursuer learns
 about the evader only through its detector; the evader is told the pursuer's pose. The
 ground truth ``in_view`` of every tick is whether any part of the evader's body is in the
-pursuer's view (:func:`pegame.geometry.body_in_view`).
+pursuer's view (:func:`pegame.visibility.body_in_view`).
 """
 
 from __future__ import annotations
@@ -27,21 +27,13 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from pegame import registry
-from pegame.api import (
-    Body,
-    Camera,
-    Context,
-    EvaderObservation,
-    Plan,
-    Pose,
-    PursuerObservation,
-    Tick,
-)
+from pegame.api import Context, EvaderObservation, PursuerObservation, Tick
+from pegame.types import Body, Camera, Plan, Pose
 from pegame.config import EnvConfig, GameConfig, resolve_map_path, typed
 from pegame.errors import SpawnError
 from pegame.files import write_atomic
-from pegame.geometry import VisibilityRegion, body_in_view, in_view, visibility_region
-from pegame.maps import OccupancyGrid, load_map
+from pegame.visibility import VisibilityRegion, body_in_view, in_view, visibility_region
+from pegame.grid import OccupancyGrid, load_map
 from pegame.metrics import TrackingMetrics
 from pegame.navigation import Planner
 

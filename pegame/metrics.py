@@ -4,7 +4,7 @@ The tracking rate is the fraction of control ticks at which the pursuer's detect
 reports the evader (paper, Table 1: "tracking success rate"). A *loss* is a maximal run of
 ticks without a detection; it ends in a *reacquisition* when a detection follows. The
 visible rate is the fraction of ticks at which any part of the evader's body is in the
-pursuer's view (:func:`pegame.geometry.body_in_view`), the ground truth beside it.
+pursuer's view (:func:`pegame.visibility.body_in_view`), the ground truth beside it.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from pegame.api import Belief, Pose
+from pegame.types import Belief, Pose
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:

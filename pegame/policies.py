@@ -28,7 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from pegame.api import Body, Context, Plan, Velocity
+from pegame.api import Context
+from pegame.types import Body, Plan, Velocity
 from pegame.envs.actions import to_velocity
 from pegame.envs.observations import EvaderFeatures, ObservationSettings, PursuerFeatures
 from pegame.envs.settings import EnvSettings

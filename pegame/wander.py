@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pegame.api import STOP, Body, Plan, Pose, Velocity
+from pegame.types import STOP, Body, Plan, Pose, Velocity
 from pegame.navigation import PathFollower, Planner
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pegame.maps import OccupancyGrid, save_map
+from pegame.grid import OccupancyGrid, save_map
 
 FAST = ["game.t_max=8", "recorder=none"]
 

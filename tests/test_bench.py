@@ -7,7 +7,7 @@ import math
 
 from pegame.bench import bench_decisions, format_report, machine
 from pegame.config import resolve_map_path
-from pegame.maps import load_map
+from pegame.grid import load_map
 
 
 def test_decision_benchmarks_time_each_part_on_a_paper_map():

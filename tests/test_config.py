@@ -9,10 +9,10 @@ import pytest
 from omegaconf import OmegaConf
 
 from pegame import registry
-from pegame.api import Camera
+from pegame.types import Camera
 from pegame.config import EnvConfig, GameConfig, resolve_map_path, typed
 from pegame.errors import ConfigError
-from pegame.maps import load_map
+from pegame.grid import load_map
 
 CONF = Path(str(files("pegame.conf")))
 

@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from pegame.api import Pose
+from pegame.types import Pose
 from pegame.config import compose
 from pegame.envs.crop import LocalCrop, local_crop_reference
 from pegame.errors import ConfigError
-from pegame.maps import OccupancyGrid
+from pegame.grid import OccupancyGrid
 
 gymnasium = pytest.importorskip("gymnasium")
 pettingzoo_test = pytest.importorskip("pettingzoo.test")

@@ -13,9 +13,10 @@ import pytest
 import yaml
 
 from pegame import registry
-from pegame.api import Body, BoundingBox, Camera, Context, Detection, Pose
+from pegame.api import Context
+from pegame.types import Body, BoundingBox, Camera, Detection, Pose
 from pegame.errors import ConfigError
-from pegame.geometry import VisibilityRegion
+from pegame.visibility import VisibilityRegion
 from pegame.estimators.kalman import KalmanEstimator
 from pegame.estimators.last_seen import LastSeen
 from pegame.estimators.particle_filter import (
@@ -28,7 +29,7 @@ from pegame.estimators.particle_filter import (
     resample,
     wrap,
 )
-from pegame.maps import FREE, OCCUPIED, OccupancyGrid
+from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 
 CONF = Path(__file__).resolve().parents[1] / "conf" / "estimator"
 DT = 0.1  # s, control period

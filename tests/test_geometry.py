@@ -1,4 +1,4 @@
-"""Tests for pegame.geometry: Algorithm 1's visibility region with occlusion, line of sight."""
+"""Tests for pegame.visibility: Algorithm 1's visibility region with occlusion, line of sight."""
 
 from __future__ import annotations
 
@@ -8,21 +8,20 @@ import numpy as np
 import pytest
 from scipy.ndimage import binary_dilation
 
-from pegame.api import Camera, Pose
-from pegame.geometry import (
+from pegame.types import Camera, Pose
+from pegame.visibility import (
     VisibilityRegion,
     body_in_view,
     _line_of_sight_reference,
     _ray_tables,
     fov_wedge,
-    grid_frame,
     in_view,
     line_of_sight,
     point_cell,
     visibility_region,
     visibility_region_reference,
 )
-from pegame.maps import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 CAMERA = Camera(fov=math.pi / 3, near=0.3, far=3.0, angle_step=0.0016, distance_step=0.05)
 BOTH = [visibility_region, visibility_region_reference]
@@ -280,7 +279,7 @@ def test_point_cell_matches_world_to_cell():
     rng = np.random.default_rng(9)
     for yaw in (0.0, -2.1):
         grid = empty_grid(resolution=0.05, origin=(0.35, -1.2, yaw))
-        frame = grid_frame(grid)
+        frame = grid.frame
         # Cell edges are where a float quotient may round either way.
         on_edges = np.round(rng.uniform(-5, 5, (500, 2)) / 0.05) * 0.05
         xy = np.concatenate([rng.uniform(-5, 5, (500, 2)), on_edges])
@@ -439,7 +438,7 @@ def test_fov_wedge_is_a_closed_ring_on_the_range_limits(near):
 
 
 def test_ray_directions_are_libm_s_beyond_the_polynomial_range():
-    from pegame.geometry import _directions
+    from pegame.visibility import _directions
 
     angles = np.linspace(-0.5, 0.5, 101)
     for theta in (0.3, -2.9, 1e7, -4e9):

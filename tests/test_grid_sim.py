@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from pegame.api import Body, Camera, Context, Pose, Velocity
-from pegame.geometry import grid_frame
-from pegame.maps import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from pegame.api import Context
+from pegame.types import Body, Camera, Pose, Velocity
+from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from pegame.navigation import inflate
 from pegame.sims.grid import GridSimulator, _sweep, _sweep_reference, saturate, unicycle
 
@@ -92,7 +92,7 @@ def test_fast_sweep_equals_reference():
     for origin in [(0.0, 0.0, 0.0), (0.3, -0.2, 1.1)]:
         grid = room(origin)
         blocked = inflate(grid, PURSUER.radius)
-        frame = grid_frame(grid)
+        frame = grid.frame
         stops = 0
         for _ in range(2000):
             sx, sy = rng.uniform(-0.5, 4.5), rng.uniform(-0.5, 3.5)

@@ -1,4 +1,4 @@
-"""Tests for pegame.maps: ROS map_server IO, grid frames and the paper maps."""
+"""Tests for pegame.grid: ROS map_server IO, grid frames and the paper maps."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from PIL import Image
 from scipy import ndimage
 
 from pegame.errors import MapError
-from pegame.maps import OccupancyGrid, load_map, save_map
+from pegame.grid import OccupancyGrid, load_map, save_map
 
 MAPS_DIR = Path(__file__).resolve().parents[1] / "maps"
 

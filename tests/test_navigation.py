@@ -10,7 +10,7 @@ import weakref
 import numpy as np
 import pytest
 
-from pegame.api import STOP, Body, Pose
+from pegame.types import STOP, Body, Pose
 from pegame.navigation import (
     LARGE_GRID_CELLS,
     LARGE_GRID_LANDMARKS,
@@ -23,7 +23,7 @@ from pegame.navigation import (
     inflate,
     shared_inflation,
 )
-from pegame.maps import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 SEEDS = [0, 1, 2, 3, 4]
 MOVES = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)]

@@ -7,9 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from pegame.api import Body, Camera, Context, Pose, SensorFrame
+from pegame.api import Context
+from pegame.types import Body, Camera, Pose, SensorFrame
 from pegame.detectors.oracle import OracleDetector
-from pegame.maps import FREE, OCCUPIED, OccupancyGrid
+from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 from pegame.registry import make_config
 
 CAMERA = Camera()  # pi/3 FOV, 0.3-5 m, 640 x 480 px

@@ -122,7 +122,8 @@ def game_with_policy(cfg):
 
 
 def observation_at(pursuer, tick):
-    from pegame.api import EMPTY_BELIEF, Pose, PursuerObservation
+    from pegame.api import PursuerObservation
+    from pegame.types import EMPTY_BELIEF, Pose
 
     return PursuerObservation(0.1 * tick, Pose(5.0, 5.0, 0.0), None, EMPTY_BELIEF, np.zeros((1, 1), bool))
 

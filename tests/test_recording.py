@@ -18,24 +18,23 @@ import numpy as np
 import pytest
 import yaml
 
-from pegame.api import (
+from pegame.api import Context, Tick
+from pegame.types import (
     Belief,
     Body,
     BoundingBox,
     Camera,
-    Context,
     Detection,
     Plan,
     Pose,
     SensorFrame,
-    Tick,
     Velocity,
 )
 from pegame.figures import plot_trajectory
 from pegame.game import Game
-from pegame.geometry import VisibilityRegion, fov_wedge, visibility_region
-from pegame.maps import OccupancyGrid
-from pegame.recording import RerunRecorder, recording_id, visibility_outlines
+from pegame.visibility import VisibilityRegion, fov_wedge, visibility_region
+from pegame.grid import OccupancyGrid
+from pegame.recorders import RerunRecorder, recording_id, visibility_outlines
 from pegame.replay import find_recordings, main as replay_main, viewer_command
 
 SHORT = ["game.t_max=5", "env=hall"]
@@ -340,7 +339,7 @@ def test_config_file_lists_every_field_with_its_default():
 
 
 def test_importing_the_recorders_does_not_import_rerun():
-    code = "import sys, pegame.recording; print('rerun' in sys.modules)"
+    code = "import sys, pegame.recorders; print('rerun' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
 
 

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from scipy.ndimage import distance_transform_edt
 
-from pegame.api import Body, Camera, Context, EvaderObservation, Pose
+from pegame.api import Context, EvaderObservation
+from pegame.types import Body, Camera, Pose
 from pegame.errors import ConfigError
 from pegame.evaders.smart import (
     MAX_RECORDED_CANDIDATES,
@@ -21,8 +22,8 @@ from pegame.evaders.smart import (
     _sample_positions,
     disc_half_widths,
 )
-from pegame.geometry import visibility_region
-from pegame.maps import FREE, OCCUPIED, OccupancyGrid, load_map
+from pegame.visibility import visibility_region
+from pegame.grid import FREE, OCCUPIED, OccupancyGrid, load_map
 from pegame.navigation import Planner
 from pegame.registry import make_config
 

@@ -12,21 +12,10 @@ import numpy as np
 import pytest
 from omegaconf import OmegaConf
 
-from pegame.api import (
-    EMPTY_BELIEF,
-    Belief,
-    Body,
-    BoundingBox,
-    Camera,
-    Context,
-    Detection,
-    Pose,
-    PursuerObservation,
-    Velocity,
-)
+from pegame.api import Context, PursuerObservation
+from pegame.types import EMPTY_BELIEF, Belief, Body, BoundingBox, Camera, Detection, Pose, Velocity
 from pegame.errors import ConfigError
-from pegame.maps import FREE, OCCUPIED, OccupancyGrid
-from pegame.geometry import grid_frame
+from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 from pegame.navigation import inflate
 from pegame.pursuers.smart import (
     SCAN,
@@ -165,7 +154,7 @@ def test_fast_look_ahead_check_equals_reference(origin):
     data[10:30, 20:24] = OCCUPIED
     grid = OccupancyGrid(data, RES, origin)
     blocked = inflate(grid, RADIUS)
-    frame = grid_frame(grid)
+    frame = grid.frame
     rng = np.random.default_rng(4)
     outcomes = set()
     for _ in range(2000):

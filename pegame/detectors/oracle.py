@@ -1,9 +1,9 @@
 """The grid simulator's camera: a geometric detector with a synthetic bounding box.
 
 The evader is detected when its centre is in view of the pursuer's camera (inside the FOV
-wedge, within [near, far] and in line of sight on the grid, :func:`pegame.geometry.in_view`),
+wedge, within [near, far] and in line of sight on the grid, :func:`pegame.visibility.in_view`),
 unless a configured miss happens. The game's ground truth is wider: any part of the body
-in view (:func:`pegame.geometry.body_in_view`), so a shoulder past a corner is visible but
+in view (:func:`pegame.visibility.body_in_view`), so a shoulder past a corner is visible but
 not detected. The evader is modelled as an upright cylinder (its body
 radius, ``evader_height``) projected through a pinhole camera of the configured FOV and
 image size (square pixels) mounted ``camera_height`` above the floor. Depth is the range
@@ -17,9 +17,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pegame.api import BoundingBox, Detection, Detector, SensorFrame
+from pegame.api import Detector
+from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame.errors import require
-from pegame.geometry import in_view
+from pegame.visibility import in_view
 
 
 class OracleDetector(Detector):

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from pegame.api import Body, Velocity
+from pegame.types import Body, Velocity
 
 
 def to_velocity(action, body: Body, clip: bool = False, who: str = "action") -> Velocity:

@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit
 from scipy.ndimage import maximum_filter
 
-from pegame.maps import OccupancyGrid
+from pegame.grid import OccupancyGrid
 
 
 @lru_cache(maxsize=16)

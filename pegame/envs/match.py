@@ -26,9 +26,10 @@ from collections.abc import Sequence
 import numpy as np
 from omegaconf import DictConfig
 
-from pegame.api import EMPTY_BELIEF, Belief, EvaderObservation, PursuerObservation, Velocity
+from pegame.api import EvaderObservation, PursuerObservation
+from pegame.types import EMPTY_BELIEF, Belief, Velocity
 from pegame.game import STREAMS, Game, spawn
-from pegame.geometry import VisibilityRegion, body_in_view
+from pegame.visibility import VisibilityRegion, body_in_view
 from pegame.metrics import TrackingMetrics
 
 ROLES = ("pursuer", "evader")

@@ -41,7 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pegame.api import Belief, Context, Detection, EvaderObservation, Pose, PursuerObservation
+from pegame.api import Context, EvaderObservation, PursuerObservation
+from pegame.types import Belief, Detection, Pose
 from pegame.envs.crop import LocalCrop
 from pegame.errors import require
 

@@ -32,9 +32,10 @@ import numpy as np
 from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
-from pegame.api import EMPTY_BELIEF, Belief, Detection, Estimator, Pose
+from pegame.api import Estimator
+from pegame.types import EMPTY_BELIEF, Belief, Detection, Pose
 from pegame.errors import require
-from pegame.geometry import VisibilityRegion
+from pegame.visibility import VisibilityRegion
 
 
 class KalmanEstimator(Estimator):

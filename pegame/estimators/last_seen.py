@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from pegame.api import EMPTY_BELIEF, Belief, Estimator
+from pegame.api import Estimator
+from pegame.types import EMPTY_BELIEF, Belief
 
 
 class LastSeen(Estimator):

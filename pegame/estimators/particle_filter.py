@@ -5,7 +5,7 @@ Sequential Importance Sampling (SIS) over the evader state (x m, y m, theta rad)
 frame (x right, y up, theta from +x, counter-clockwise, in (-pi, pi]). The filter is given
 the map (``context.grid``), the evader's max speed (``context.evader.v_max``, m/s) and, at
 every control tick, the pursuer's detection (or None) and visibility region V_k^p (a
-:class:`pegame.geometry.VisibilityRegion`); never the true evader pose.
+:class:`pegame.visibility.VisibilityRegion`); never the true evader pose.
 
 - Motion model, the paper's unicycle u = [V cos(phi), V sin(phi), omega]: every particle
   draws a speed V ~ U[0, v_max] (m/s) and a turn rate omega ~ N(0, turn_rate_std^2) (rad/s)
@@ -60,9 +60,10 @@ import numpy as np
 from numba import njit
 from scipy.ndimage import distance_transform_edt
 
-from pegame.api import Belief, Detection, Estimator, Pose
+from pegame.api import Estimator
+from pegame.types import Belief, Detection, Pose
 from pegame.errors import MapError, require
-from pegame.geometry import VisibilityRegion
+from pegame.visibility import VisibilityRegion
 from pegame.trig import MAX_ANGLE, sin_cos
 
 log = logging.getLogger(__name__)
@@ -270,8 +271,7 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
     headings' sines and cosines come from :func:`pegame.trig.sin_cos` (within 2^-52 of
     numpy's) and the cells from ``OccupancyGrid.world_to_cell`` operation for operation.
 
-    frame: the grid's (origin x m, origin y m, whether the origin yaw is nonzero,
-    cos yaw, sin yaw, resolution m).
+    frame: the grid's :class:`pegame.grid.GridFrame`.
     """
     n = particles.shape[0]
     moved = np.empty((n, 3))
@@ -285,7 +285,8 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
     for i in range(n):  # its own pass: the branches slow the passes above 2.5x
         moved[i, 2] = _wrap_angle(moved[i, 2])
     cells = np.empty(n, dtype=np.int64)
-    ox, oy, rotate, c, s, res = frame
+    ox, oy, res, rotate = frame.ox, frame.oy, frame.resolution, frame.rotated
+    c, s = frame.cos_yaw, frame.sin_yaw
     height, width = blocked.shape
     for i in range(n):
         if not abs(heading[i]) <= MAX_ANGLE:
@@ -414,8 +415,6 @@ class ParticleFilter(Estimator):
         self._free_cells = np.flatnonzero(~self._blocked)
         if self._free_cells.size == 0:
             raise MapError(f"Map '{grid.name}' has no free cell for the particle filter to use.")
-        ox, oy, yaw = grid.origin
-        self._frame = (ox, oy, yaw != 0.0, math.cos(yaw), math.sin(yaw), float(grid.resolution))
         n = config.n_particles
         self.particles = np.zeros((n, 3))
         self.weights = np.full(n, 1.0 / n)
@@ -490,7 +489,7 @@ class ParticleFilter(Estimator):
         cfg = self.config
         moved, cells = _move_and_locate(
             self.particles, *self._draw(), self.context.evader.v_max, cfg.turn_rate_std, dt,
-            self._frame, self.context.grid.blocked,
+            self.context.grid.frame, self.context.grid.blocked,
         )
         seen = visible.holds(cells)  # V only where the particles are (module docstring)
         if detection is None:

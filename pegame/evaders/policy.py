@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pegame.api import Evader, EvaderObservation, Plan, Pose, Velocity
+from pegame.api import Evader, EvaderObservation
+from pegame.types import Plan, Pose, Velocity
 from pegame.policies import PolicyOptions, PolicyPlayer
 
 

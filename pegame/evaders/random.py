@@ -3,7 +3,8 @@ knowledge of the pursuer (paper, Sec. "Random Pursuer and Evader")."""
 
 from __future__ import annotations
 
-from pegame.api import Evader, EvaderObservation, Plan, Velocity
+from pegame.api import Evader, EvaderObservation
+from pegame.types import Plan, Velocity
 from pegame.wander import Wanderer
 
 

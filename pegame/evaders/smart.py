@@ -3,7 +3,7 @@
 At every decision the evader is told the pursuer's pose (the paper's assumption) and:
 
 1. computes the pursuer's visibility region V (Algorithm 1, with occlusion:
-   :func:`pegame.geometry.visibility_region` for ``context.camera``);
+   :func:`pegame.visibility.visibility_region` for ``context.camera``);
 2. takes as candidate goals the cells of F \\ V it can reach: traversable for its radius
    and connected to its own cell (:meth:`pegame.navigation.Planner.reachable`), minus V;
 3. scores each candidate i with Algorithm 2's
@@ -46,7 +46,7 @@ replanned only when the chosen goal moves by more than one cell (Chebyshev dista
 the goal being followed. ``candidate_stride`` k > 1 scores only the cells whose row and
 column are both multiples of k (about 1/k^2 of them).
 
-Units and frames: metres, seconds and radians in the map frame of :mod:`pegame.maps`
+Units and frames: metres, seconds and radians in the map frame of :mod:`pegame.grid`
 (x right, y up, row 0 = lowest y). Candidates are cell centres.
 
 Fast path. :meth:`SmartEvader.escape` returns the same goal, cost and recorded
@@ -81,9 +81,10 @@ import numpy as np
 from numba import njit
 from scipy.ndimage import distance_transform_edt
 
-from pegame.api import STOP, Evader, EvaderObservation, Plan, Pose, Velocity
+from pegame.api import Evader, EvaderObservation
+from pegame.types import STOP, Plan, Pose, Velocity
 from pegame.errors import require
-from pegame.geometry import VisibilityRegion, visibility_region
+from pegame.visibility import VisibilityRegion, visibility_region
 from pegame.navigation import PathFollower, Planner
 
 log = logging.getLogger(__name__)

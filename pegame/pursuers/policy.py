@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pegame.api import Plan, Pose, Pursuer, PursuerObservation, Velocity
+from pegame.api import Pursuer, PursuerObservation
+from pegame.types import Plan, Pose, Velocity
 from pegame.policies import PolicyOptions, PolicyPlayer
 
 

@@ -3,7 +3,8 @@ ignores what it sees (paper, Sec. "Random Pursuer and Evader")."""
 
 from __future__ import annotations
 
-from pegame.api import Plan, Pursuer, PursuerObservation, Velocity
+from pegame.api import Pursuer, PursuerObservation
+from pegame.types import Plan, Velocity
 from pegame.wander import Wanderer
 
 

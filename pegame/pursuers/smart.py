@@ -38,10 +38,11 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from pegame.api import Plan, Pose, Pursuer, PursuerObservation, Velocity, wrap_angle
+from pegame.api import Pursuer, PursuerObservation
+from pegame.types import Plan, Pose, Velocity, clamp, wrap_angle
 from pegame.errors import require
-from pegame.geometry import grid_frame, point_cell
-from pegame.maps import OccupancyGrid
+from pegame.visibility import point_cell
+from pegame.grid import OccupancyGrid
 from pegame.navigation import PathFollower, Planner, shared_inflation
 
 log = logging.getLogger(__name__)
@@ -77,7 +78,7 @@ class SmartPursuer(Pursuer):
         self.planner = Planner.shared(context.grid, context.pursuer.radius)
         self.follower = PathFollower(context.pursuer)
         self.blocked = shared_inflation(context.grid, context.pursuer.radius)
-        self._frame = grid_frame(context.grid)
+        self._frame = context.grid.frame
         self.reset(Pose(0.0, 0.0))
 
     def reset(self, pose: Pose) -> None:
@@ -116,8 +117,8 @@ class SmartPursuer(Pursuer):
         detection, body = observation.detection, self.context.pursuer
         width = self.context.camera.image_width
         offset = (detection.box.x + 0.5 * detection.box.w - 0.5 * width) / width
-        w = _clamp(-self.config.k_w * offset, body.w_max)
-        v = _clamp(self.config.k_v * (detection.depth - self.config.standoff), body.v_max)
+        w = clamp(-self.config.k_w * offset, body.w_max)
+        v = clamp(self.config.k_v * (detection.depth - self.config.standoff), body.v_max)
         reach = math.copysign(max(abs(v) * LOOKAHEAD_TIME, body.radius), v)
         if v != 0.0 and not self._clear(observation.pose, reach):
             return self._detour(observation, w) if v > 0 else Velocity(0.0, w)
@@ -179,9 +180,6 @@ class SmartPursuer(Pursuer):
         if abs(bearing) > 0.5 * self.context.camera.fov:
             self._scan_sign = math.copysign(1.0, bearing)
 
-
-def _clamp(value: float, limit: float) -> float:
-    return max(-limit, min(limit, value))
 
 
 @njit(cache=True)

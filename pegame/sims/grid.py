@@ -17,8 +17,9 @@ from dataclasses import dataclass
 
 from numba import njit
 
-from pegame.api import Body, Pose, SensorFrame, Simulator, Velocity, wrap_angle
-from pegame.geometry import cell_blocked, grid_frame, point_cell
+from pegame.api import Simulator
+from pegame.types import Body, Pose, SensorFrame, Velocity, wrap_angle
+from pegame.visibility import cell_blocked, point_cell
 from pegame.navigation import shared_inflation
 
 
@@ -48,7 +49,7 @@ def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
 def _sweep(blocked, sx, sy, tx, ty, n, frame):
     """The last of the points k/n along the chord from (sx, sy) to (tx, ty) (m, map frame),
     k = 1..n, before the first one whose cell is off the grid or True in ``blocked``;
-    (sx, sy) when that is the first. ``frame``: :func:`pegame.geometry.grid_frame`."""
+    (sx, sy) when that is the first. ``frame``: the grid's :class:`pegame.grid.GridFrame`."""
     x, y = sx, sy
     for k in range(1, n + 1):
         nx = sx + (tx - sx) * k / n
@@ -80,7 +81,7 @@ class _Agent:
         self.grid = grid
         self.body = body
         self.blocked = shared_inflation(grid, body.radius)
-        self.frame = grid_frame(grid)
+        self.frame = grid.frame
         self.pose = Pose(0.0, 0.0, 0.0)
 
     def collides(self, x: float, y: float) -> bool:

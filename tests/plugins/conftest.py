@@ -11,8 +11,9 @@ import sys
 import pytest
 
 from pegame import registry
-from pegame.api import Body, Camera, Context
-from pegame.maps import OccupancyGrid
+from pegame.api import Context
+from pegame.types import Body, Camera
+from pegame.grid import OccupancyGrid
 from plugin_worlds import small_map
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pegame.maps import OccupancyGrid
+from pegame.grid import OccupancyGrid
 
 RESOLUTION = 0.05  # m per cell
 WALL_X = 2.0  # m, the near face of the interior wall

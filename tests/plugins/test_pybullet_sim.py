@@ -13,9 +13,10 @@ import math  # noqa: E402
 import numpy as np  # noqa: E402
 import pybullet  # noqa: E402
 
-from pegame.api import Pose, Velocity  # noqa: E402
+from pegame.api import Velocity  # noqa: E402
+from pegame.types import Pose
 from pegame.errors import ConfigError  # noqa: E402
-from pegame.maps import OccupancyGrid  # noqa: E402
+from pegame.grid import OccupancyGrid  # noqa: E402
 from pegame_pybullet.bench import _rss_mb  # noqa: E402
 from pegame_pybullet.sim import PybulletSimulator  # noqa: E402
 from pegame_pybullet.world import merge_rectangles  # noqa: E402

@@ -10,7 +10,8 @@ import math  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from pegame.api import Pose, SensorFrame  # noqa: E402
+from pegame.api import SensorFrame  # noqa: E402
+from pegame.types import Pose
 from pegame.errors import ConfigError  # noqa: E402
 from pegame_pybullet.segmentation import SegmentationDetector  # noqa: E402
 from pegame_pybullet.sim import PybulletSimulator  # noqa: E402

@@ -12,9 +12,10 @@ import math  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from pegame.api import Body, Camera, Context, Pose, SensorFrame  # noqa: E402
+from pegame.api import Context, SensorFrame  # noqa: E402
+from pegame.types import Body, Camera, Pose
 from pegame.errors import ConfigError  # noqa: E402
-from pegame.maps import OccupancyGrid  # noqa: E402
+from pegame.grid import OccupancyGrid  # noqa: E402
 from pegame_pybullet.segmentation import SegmentationDetector  # noqa: E402
 from pegame_pybullet.sim import PybulletSimulator  # noqa: E402
 from pegame_vision.detector import VisionDetector  # noqa: E402

@@ -2,7 +2,7 @@
 
 - :func:`rtf`: real-time factor of whole games (simulated seconds per second).
 - :func:`visibility_agreement`: how often "evader pixels present" in PyBullet agrees with
-  the grid simulator's geometric visibility (:func:`pegame.geometry.body_in_view`), and why
+  the grid simulator's geometric visibility (:func:`pegame.visibility.body_in_view`), and why
   not.
 - :func:`memory_growth`: resident memory over many reset/close cycles in one process.
 """
@@ -21,10 +21,10 @@ from typing import Any
 import numpy as np
 
 from pegame import registry
-from pegame.api import Pose, Velocity
+from pegame.types import Pose, Velocity
 from pegame.config import compose
 from pegame.game import Game, spawn
-from pegame.geometry import line_of_sight
+from pegame.visibility import line_of_sight
 
 ARC = Velocity(0.3, 0.5)  # m/s, rad/s: a command that keeps the agents moving
 
@@ -80,7 +80,7 @@ def visibility_agreement(env: str = "enclosed", seeds: Iterable[int] = range(3),
     ``seeds``), then every tick's poses are placed in PyBullet and rendered. "Pixels" means
     the segmentation detector finds the evader (at least ``min_pixels`` evader pixels within
     the camera's range), "in view" is the game's ground truth,
-    :func:`pegame.geometry.body_in_view` of the evader's body (a cylinder of its radius).
+    :func:`pegame.visibility.body_in_view` of the evader's body (a cylinder of its radius).
     With ``min_visible`` > 0, pixels count only when at least that fraction of the evader's
     body is visible (:meth:`PybulletSimulator.evader_visible_fraction`, an extra render per
     tick). Returns the fraction of ticks where both agree, the tick count, and the

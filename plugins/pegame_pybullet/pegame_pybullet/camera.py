@@ -30,7 +30,7 @@ import math
 import numpy as np
 import pybullet
 
-from pegame.api import Pose
+from pegame.types import Pose
 from pegame_pybullet.client import Client
 
 FLOOR_RGB = (107, 107, 107)  # uint8: the floor body as TinyRenderer shades it (measured)

@@ -2,7 +2,7 @@
 
 The evader's pixels are exactly those labelled ``evader`` in ``frame.segmentation``,
 kept when their back-projected point lies within the camera's sensing range [near, far]
-(m, horizontal distance from the camera, as :func:`pegame.geometry.in_view` measures it).
+(m, horizontal distance from the camera, as :func:`pegame.visibility.in_view` measures it).
 With fewer than ``min_pixels`` of them there is no detection. Otherwise (paper, Sec.
 "Object tracking from static camera"):
 
@@ -23,7 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pegame.api import BoundingBox, Detection, Detector, SensorFrame
+from pegame.api import Detector
+from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame.errors import ConfigError, require
 
 

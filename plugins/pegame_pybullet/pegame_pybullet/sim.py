@@ -41,7 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet
 
-from pegame.api import Body, Pose, SensorFrame, Simulator, Velocity
+from pegame.api import Simulator
+from pegame.types import Body, Pose, SensorFrame, Velocity
 from pegame.errors import ConfigError, require
 from pegame.sims.grid import saturate, unicycle
 from pegame_pybullet.bodies import EVADER_HEIGHT, PURSUER_HEIGHT, create_body, person, turtlebot

@@ -16,7 +16,7 @@ from functools import lru_cache
 import numpy as np
 import pybullet
 
-from pegame.maps import OccupancyGrid
+from pegame.grid import OccupancyGrid
 from pegame_pybullet.client import Client
 
 WALL_RGBA = (0.72, 0.72, 0.70, 1.0)  # neutral grey: nothing in the scenery has a clothing hue

@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pegame.api import BoundingBox, Detection, Detector, SensorFrame
+from pegame.api import Detector
+from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame.errors import ConfigError, require
 from pegame_vision.colour import ColourModel, find_blobs, parse_hex
 from pegame_vision.opencv import cv2

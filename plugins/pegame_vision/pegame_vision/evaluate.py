@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from pegame import registry
-from pegame.api import BoundingBox, Detection, Pose, SensorFrame
+from pegame.types import BoundingBox, Detection, Pose, SensorFrame
 from pegame.config import compose
 from pegame.game import Game
 

@@ -43,7 +43,7 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, NamedTuple
 
 import numpy as np
 import yaml
@@ -54,6 +54,24 @@ from pegame.errors import MapError
 FREE = 0
 OCCUPIED = 100
 UNKNOWN = -1
+
+
+class GridFrame(NamedTuple):
+    """The map-to-cell transform of a grid, as numba kernels read it (by field name).
+
+    (ox, oy): the map-frame position of cell (0, 0)'s lower-left corner (m); cos_yaw and
+    sin_yaw of the origin's yaw; rotated: whether that yaw is nonzero (the kernels skip the
+    rotation otherwise, as :meth:`OccupancyGrid.world_to_cell` does); resolution: cell edge
+    length (m). A point (x, y) lies in row floor(v / resolution), column floor(u /
+    resolution) with (u, v) = R(-yaw) (x - ox, y - oy).
+    """
+
+    ox: float
+    oy: float
+    cos_yaw: float
+    sin_yaw: float
+    rotated: bool
+    resolution: float
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,6 +88,7 @@ class OccupancyGrid:
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
     name: str = "map"
     blocked: np.ndarray = field(init=False, repr=False)
+    frame: GridFrame = field(init=False, repr=False)  # the map-to-cell transform for kernels
 
     def __post_init__(self) -> None:
         data = np.ascontiguousarray(self.data, dtype=np.int8)
@@ -79,6 +98,9 @@ class OccupancyGrid:
         blocked.setflags(write=False)
         object.__setattr__(self, "blocked", blocked)
         object.__setattr__(self, "origin", tuple(float(v) for v in self.origin))
+        ox, oy, yaw = self.origin
+        frame = GridFrame(ox, oy, math.cos(yaw), math.sin(yaw), yaw != 0.0, float(self.resolution))
+        object.__setattr__(self, "frame", frame)
 
     @property
     def height(self) -> int:

@@ -77,7 +77,8 @@ from typing import Any
 
 import numpy as np
 
-from pegame.api import Pose, Recorder, Tick
+from pegame.api import Recorder, Tick
+from pegame.types import Pose
 from pegame.errors import require
 
 log = logging.getLogger(__name__)
@@ -629,7 +630,7 @@ def _xyz(xy, z: float) -> np.ndarray:
 @lru_cache(maxsize=16)
 def fov_template(camera) -> np.ndarray:
     """The camera's FOV wedge (``geometry.fov_wedge``) at the zero pose, (K, 2) m."""
-    from pegame.geometry import fov_wedge
+    from pegame.visibility import fov_wedge
 
     return fov_wedge(camera, Pose(0.0, 0.0, 0.0), n=16)
 
@@ -758,7 +759,7 @@ def visibility_outlines(grid, xs: np.ndarray, ys: np.ndarray, thetas: np.ndarray
     ``rays`` rays at the centres of equal slices of the FOV are cast from the camera one
     cell at a time up to the first blocked cell or the far range; each polygon runs along
     their far ends from the near range on, then back along the near arc. It draws the
-    region that :func:`pegame.geometry.visibility_region` computes, at ``rays`` angles
+    region that :func:`pegame.visibility.visibility_region` computes, at ``rays`` angles
     instead of every ``camera.angle_step``. The compiled kernel skips the cells that the
     grid's :func:`free_runs` shows to be free, with the same result as compiled=False, the
     plain Python reference that samples every cell.

@@ -13,7 +13,7 @@ plan. This module provides the same three pieces for occupancy grids:
 * :class:`PathFollower` - a pure-pursuit local controller for a unicycle.
 
 Units and frames: positions are map-frame (x, y) in metres (ROS conventions, see
-:mod:`pegame.maps`), headings and angles in radians, speeds in m/s and rad/s. Grid
+:mod:`pegame.grid`), headings and angles in radians, speeds in m/s and rad/s. Grid
 arrays are (height, width) indexed [row, col] with row 0 the lowest y; distances and
 costs are in metres.
 
@@ -45,9 +45,9 @@ import numpy as np
 from numba import njit
 from scipy import ndimage
 
-from pegame.api import STOP, Body, Pose, Velocity, wrap_angle
+from pegame.types import STOP, Body, Pose, Velocity, clamp, wrap_angle
 from pegame.errors import require
-from pegame.maps import OccupancyGrid
+from pegame.grid import OccupancyGrid
 
 SQRT2 = math.sqrt(2.0)
 
@@ -892,15 +892,12 @@ class PathFollower:
         error = wrap_angle(math.atan2(dy, dx) - pose.theta)
         v_max, w_max = self.body.v_max, self.body.w_max
         if abs(error) > self.rotate_threshold:
-            return Velocity(0.0, _clamp(self.turn_gain * error, w_max))
+            return Velocity(0.0, clamp(self.turn_gain * error, w_max))
         # Pure pursuit: the arc through the target tangent to the heading has curvature
         # 2 sin(error) / distance.
         curvature = 2.0 * math.sin(error) / max(math.hypot(dx, dy), 1e-9)
         v = v_max * min(1.0, max(self.remaining, to_goal) / self.lookahead)
         if abs(curvature) * v > w_max:
             v = w_max / abs(curvature)
-        return Velocity(v, _clamp(curvature * v, w_max))
+        return Velocity(v, clamp(curvature * v, w_max))
 
-
-def _clamp(value: float, limit: float) -> float:
-    return max(-limit, min(limit, value))

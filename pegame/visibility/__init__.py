@@ -15,15 +15,16 @@ obstacle, not as a place where the evader could be seen. Samples closer than ``n
 are not marked but still occlude. A camera in a blocked cell sees nothing.
 
 Units and frames: positions in metres and angles in radians, all in the map frame of
-:mod:`pegame.maps` (x right, y up); poses are :class:`pegame.api.Pose`. Map-frame points
+:mod:`pegame.grid` (x right, y up); poses are :class:`pegame.api.Pose`. Map-frame points
 go to cells exactly as :meth:`OccupancyGrid.world_to_cell` does, origin yaw included.
 
 Two implementations give identical masks: :func:`visibility_region_reference`, plain
 vectorised numpy over all rays and samples, and the numba ray march behind
 :func:`visibility_region`, which stops each ray at its first blocked sample. Likewise
 :func:`line_of_sight` is a numba kernel with the numpy reference
-``_line_of_sight_reference``. The small numba helpers :func:`grid_frame`,
-:func:`point_cell` and :func:`cell_blocked` serve other modules' kernels too.
+``_line_of_sight_reference``. The small numba helpers :func:`point_cell`
+and :func:`cell_blocked` (on a grid's :class:`pegame.grid.GridFrame`) serve other modules'
+kernels too.
 :class:`VisibilityRegion` computes the same mask on demand, or only the part of it that
 a caller asks about; :func:`body_in_view` extends :func:`in_view` from a point to a body.
 """
@@ -36,8 +37,8 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
-from pegame.api import Camera, Pose, wrap_angle
-from pegame.maps import OccupancyGrid
+from pegame.types import Camera, Pose, wrap_angle
+from pegame.grid import OccupancyGrid
 from pegame.trig import MAX_ANGLE, sin_cos
 
 
@@ -109,26 +110,20 @@ def visibility_region_reference(grid: OccupancyGrid, pose: Pose, camera: Camera)
 
 
 # ------------------------------------------------------------------ numba helpers
-# The kernels take the map-to-cell transform as a "frame" tuple (ox, oy, cos yaw, sin yaw,
-# yaw != 0, resolution) and reproduce OccupancyGrid.world_to_cell operation for operation,
-# so they pick exactly the cells that the numpy code picks.
-
-
-def grid_frame(grid: OccupancyGrid) -> tuple[float, float, float, float, bool, float]:
-    """The frame tuple of ``grid`` for :func:`point_cell` and the kernels."""
-    ox, oy, yaw = grid.origin
-    return ox, oy, math.cos(yaw), math.sin(yaw), yaw != 0.0, float(grid.resolution)
+# The kernels take the map-to-cell transform as a GridFrame (OccupancyGrid.frame) and
+# reproduce OccupancyGrid.world_to_cell operation for operation, so they pick exactly the
+# cells that the numpy code picks.
 
 
 @njit(cache=True, inline="always")
 def point_cell(x, y, frame):
     """(row, col) of the cell containing map point (x, y) (m); may lie off the grid."""
-    ox, oy, c, s, rotate, res = frame
-    dx = x - ox
-    dy = y - oy
-    if rotate:
+    dx = x - frame.ox
+    dy = y - frame.oy
+    if frame.rotated:
+        c, s = frame.cos_yaw, frame.sin_yaw
         dx, dy = c * dx + s * dy, -s * dx + c * dy
-    return math.floor(dy / res), math.floor(dx / res)
+    return math.floor(dy / frame.resolution), math.floor(dx / frame.resolution)
 
 
 @njit(cache=True, inline="always")
@@ -155,7 +150,8 @@ def _ray_cells(px, py, ray, distances, frame, shape, divide, cells):
     the function returns False when any sample came within _EDGE cells of a cell edge (the
     caller then redoes the ray with ``divide``) and True otherwise.
     """
-    ox, oy, c, s, rotate, res = frame
+    ox, oy, res, rotate = frame.ox, frame.oy, frame.resolution, frame.rotated
+    c, s = frame.cos_yaw, frame.sin_yaw
     cos_i, sin_i = ray
     height, width = shape
     inv = 1.0 / res
@@ -256,7 +252,7 @@ def _whole_region(grid: OccupancyGrid, pose: Pose, camera: Camera):
     cos_a, sin_a = _ray_directions(pose, camera)
     mask = np.zeros(grid.blocked.shape, dtype=bool)
     px, py = float(pose.x), float(pose.y)
-    bounds = _march(grid.blocked, cos_a, sin_a, distances, first, px, py, grid_frame(grid), mask)
+    bounds = _march(grid.blocked, cos_a, sin_a, distances, first, px, py, grid.frame, mask)
     return mask, bounds
 
 
@@ -341,7 +337,7 @@ class VisibilityRegion:
         grid, pose, camera = self.grid, self.pose, self.camera
         angles, distances, first = _ray_tables(camera)
         return (
-            grid.blocked, grid_frame(grid), float(grid.origin[2]), float(pose.x), float(pose.y),
+            grid.blocked, grid.frame, float(grid.origin[2]), float(pose.x), float(pose.y),
             float(pose.theta), angles, distances, first, camera.angle_step, camera.distance_step,
             camera.fov, camera.far,
         )
@@ -351,7 +347,7 @@ class VisibilityRegion:
 def _mask_over(blocked, frame, yaw, px, py, theta, angles, distances, first, angle_step,
                distance_step, fov, far, row0, row1, col0, col1):
     """Kernel of :meth:`VisibilityRegion.mask_over`: march the rays reaching the block."""
-    ox, oy, _, _, _, resolution = frame
+    ox, oy, resolution = frame.ox, frame.oy, frame.resolution
     i0, i1, samples = _rays_reaching(
         angles, angle_step, distance_step, distances.size, px, py, theta, ox, oy, yaw,
         resolution, row0, row1, col0, col1,
@@ -367,7 +363,7 @@ def _mask_over(blocked, frame, yaw, px, py, theta, angles, distances, first, ang
 def _holds(cells, blocked, frame, yaw, px, py, theta, angles, distances, first, angle_step,
            distance_step, fov, far):
     """Kernel of :meth:`VisibilityRegion.holds` for a region not yet computed whole."""
-    ox, oy, _, _, _, resolution = frame
+    ox, oy, resolution = frame.ox, frame.oy, frame.resolution
     near, (r0, r1, c0, c1) = _near_wedge(
         cells, blocked.shape[1], px, py, theta, ox, oy, yaw, resolution, fov, far
     )
@@ -517,7 +513,7 @@ def line_of_sight(grid: OccupancyGrid, a_xy, b_xy, step: float | None = None) ->
         raise ValueError(f"step must be positive, got {step}")
     ax, ay = float(a_xy[0]), float(a_xy[1])
     bx, by = float(b_xy[0]), float(b_xy[1])
-    return _segment_clear(grid.blocked, ax, ay, bx, by, step, grid_frame(grid))
+    return _segment_clear(grid.blocked, ax, ay, bx, by, step, grid.frame)
 
 
 def in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, point_xy) -> bool:

@@ -1,0 +1,196 @@
+"""Value types that plugins exchange, and the small helpers shared by every module.
+
+Conventions (see DESIGN.md): SI units (m, s, rad); angles wrapped to (-pi, pi]; the map
+frame is ROS's (x right, y up, origin at the lower-left corner of cell (row 0, col 0));
+value types are frozen dataclasses; arrays are numpy with documented shapes. Nothing here
+imports another pegame module but :mod:`pegame.errors`, so every module can import it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pegame.errors import require
+
+
+def wrap_angle(angle: float) -> float:
+    """Wrap an angle in radians to (-pi, pi]."""
+    wrapped = math.remainder(angle, 2.0 * math.pi)
+    return math.pi if wrapped == -math.pi else wrapped
+
+
+def clamp(value: float, limit: float) -> float:
+    """``value`` limited to [-limit, limit] (limit >= 0)."""
+    return max(-limit, min(limit, value))
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A planar pose in the map frame: position (m) and heading theta (rad, from +x, CCW)."""
+
+    x: float
+    y: float
+    theta: float = 0.0
+
+    @property
+    def xy(self) -> np.ndarray:
+        """Position as a float array of shape (2,), metres."""
+        return np.array([self.x, self.y])
+
+    def distance_to(self, other: Pose) -> float:
+        """Euclidean distance between the two positions, metres."""
+        return math.hypot(other.x - self.x, other.y - self.y)
+
+
+@dataclass(frozen=True)
+class Velocity:
+    """A unicycle command: forward speed v (m/s) and turn rate w (rad/s, CCW positive)."""
+
+    v: float = 0.0
+    w: float = 0.0
+
+
+STOP = Velocity(0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Body:
+    """An agent's physical limits: disc radius (m), max speed (m/s), max turn rate (rad/s)."""
+
+    radius: float
+    v_max: float
+    w_max: float
+
+
+@dataclass(frozen=True)
+class Camera:
+    """The pursuer's forward-facing camera, a pinhole looking along the robot's heading.
+
+    fov: horizontal field of view (rad); near/far: sensing range (m); image_width and
+    image_height in pixels; angle_step (rad) and distance_step (m) are the ray-casting
+    resolution of the paper's Algorithm 1.
+    """
+
+    fov: float = math.pi / 3
+    near: float = 0.3
+    far: float = 5.0
+    image_width: int = 640
+    image_height: int = 480
+    angle_step: float = 0.0016
+    distance_step: float = 0.05
+
+    def __post_init__(self) -> None:
+        require(0 < self.fov <= 2 * math.pi, "camera.fov", "(0, 2*pi] radians", self.fov)
+        require(self.near >= 0, "camera.near", "a range >= 0 m", self.near)
+        require(self.far > self.near, "camera.far", f"a range > camera.near ({self.near} m)", self.far)
+        for key in ("image_width", "image_height", "angle_step", "distance_step"):
+            value = getattr(self, key)
+            require(value > 0, f"camera.{key}", "a positive number", value)
+
+    @property
+    def focal_px(self) -> float:
+        """Horizontal focal length in pixels: (image_width / 2) / tan(fov / 2)."""
+        return 0.5 * self.image_width / math.tan(0.5 * self.fov)
+
+    def column_of(self, bearing: float) -> float:
+        """Image column (px, 0 = left edge) of a ray at ``bearing`` rad left of the optical axis."""
+        return 0.5 * self.image_width - self.focal_px * math.tan(bearing)
+
+    def bearing_of(self, column: float) -> float:
+        """Bearing (rad, left positive) of image column ``column`` (px); inverse of column_of."""
+        return math.atan2(0.5 * self.image_width - column, self.focal_px)
+
+
+@dataclass(frozen=True)
+class BoundingBox:
+    """An axis-aligned image box: top-left corner (x, y) and size (w, h), all in pixels."""
+
+    x: float
+    y: float
+    w: float
+    h: float
+
+    @property
+    def center_x(self) -> float:
+        return self.x + 0.5 * self.w
+
+
+@dataclass(frozen=True, eq=False)
+class SensorFrame:
+    """What the pursuer's camera delivers at one control tick.
+
+    time: simulation time (s). camera_pose: the camera's pose in the map frame.
+    rgb (H, W, 3) uint8, depth (H, W) float32 metres, segmentation (H, W) int: present only
+    when the simulator renders images. evader_truth: the simulator's ground-truth evader
+    pose, for simulator-side detectors (oracle, segmentation) only; strategies and
+    estimators never receive a SensorFrame.
+
+    With rendered images, a camera's calibration as a depth camera driver gives it:
+    intrinsics, the (3, 3) pinhole matrix K of rgb and depth in their own pixels (pixel
+    (row i, col j) spans [j, j+1] x [i, i+1], so its centre is at (j + 0.5, i + 0.5));
+    depth is the distance along the optical axis (m), inf where nothing is within range;
+    camera_to_map, the (4, 4) homogeneous transform from the optical frame (x right, y
+    down, z forward; m) to the map frame with z up and the floor at z = 0 (it holds the
+    camera's height and tilt); labels, segmentation values by name (e.g. ``"evader"``),
+    for simulator-side detectors only.
+    """
+
+    time: float
+    camera_pose: Pose
+    evader_truth: Pose | None = None
+    rgb: np.ndarray | None = None
+    depth: np.ndarray | None = None
+    segmentation: np.ndarray | None = None
+    intrinsics: np.ndarray | None = None
+    camera_to_map: np.ndarray | None = None
+    labels: dict[str, int] | None = None
+
+
+@dataclass(frozen=True)
+class Detection:
+    """The evader as seen by the pursuer's detector.
+
+    box: image bounding box (px); depth: range along the optical axis to the evader (m);
+    position: the evader's estimated (x, y) in the map frame (m); confidence in [0, 1].
+    """
+
+    box: BoundingBox
+    depth: float
+    position: tuple[float, float]
+    confidence: float = 1.0
+
+
+@dataclass(frozen=True, eq=False)
+class Belief:
+    """An estimator's belief about the evader's position.
+
+    mean: estimated (x, y) in the map frame (m), or None when the estimator has nothing
+    yet. covariance: (2, 2) m^2 or None. particles: (N, 3) states (x m, y m, theta rad)
+    and weights: (N,) summing to 1, for particle estimators. n_eff: effective sample
+    size 1 / sum(w^2). resampled: whether this update resampled.
+    """
+
+    mean: tuple[float, float] | None
+    covariance: np.ndarray | None = None
+    particles: np.ndarray | None = None
+    weights: np.ndarray | None = None
+    n_eff: float | None = None
+    resampled: bool = False
+
+
+EMPTY_BELIEF = Belief(mean=None)
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """A strategy's decision: a goal (x, y) in the map frame (m) or None, the path to it as
+    (K, 2) waypoints in metres (empty when there is none), and free-form ``info`` that the
+    recorder shows (for example the smart evader's candidate set)."""
+
+    goal: tuple[float, float] | None = None
+    path: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    info: dict[str, Any] = field(default_factory=dict)

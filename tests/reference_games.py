@@ -1,0 +1,62 @@
+"""Reference games: every built-in plugin played on fixed seeds, their measures stored.
+
+``python tests/reference_games.py`` plays them and writes ``tests/data/reference_games.json``;
+``tests/test_reference_games.py`` plays them again and requires the same measures, so a
+refactoring that changes a game fails. Regenerate only for a change that is meant to
+change games, and say so in its commit.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+DATA = Path(__file__).resolve().parent / "data" / "reference_games.json"
+
+SHORT = ["game.t_max=20", "recorder=none"]
+
+#: (label, overrides); each is played with seeds SEEDS
+CASES = [
+    ("S-S enclosed", ["env=enclosed", "pursuer=smart", "evader=smart"]),
+    ("S-S brick ratio 0.5", ["env=brick", "pursuer=smart", "evader=smart", "game.speed_ratio=0.5"]),
+    ("S-R hall ratio 2", ["env=hall", "pursuer=smart", "evader=random", "game.speed_ratio=2"]),
+    ("R-R enclosed", ["env=enclosed", "pursuer=random", "evader=random"]),
+    ("R-S brick", ["env=brick", "pursuer=random", "evader=smart"]),
+    ("S-S kalman", ["env=enclosed", "estimator=kalman"]),
+    ("S-S last_seen", ["env=brick", "estimator=last_seen"]),
+    ("S-S stratified", ["env=enclosed", "estimator.resampler=stratified"]),
+    ("S-S residual", ["env=hall", "estimator.resampler=residual"]),
+    ("S-S multinomial", ["env=brick", "estimator.resampler=multinomial"]),
+    ("policy-S", ["env=enclosed", "pursuer=policy", f"pursuer.path={EXAMPLES / 'cem_pursuer.npz'}"]),
+    ("S-S decision 2 Hz", ["env=enclosed", "game.decision_hz=2"]),
+    ("S-S pybullet segmentation", ["sim=pybullet", "detector=segmentation", "game.t_max=6"]),
+    ("S-R pybullet vision", ["sim=pybullet", "detector=vision", "evader=random", "game.t_max=6"]),
+]
+SEEDS = (0, 1)
+
+
+def play(overrides: list[str], seed: int) -> dict:
+    """The result of one game (no files written)."""
+    from pegame.config import compose
+    from pegame.game import Game
+
+    cfg = compose([*SHORT, *overrides, f"game.seed={seed}"])
+    return Game(cfg).play("unused").result
+
+
+def main() -> int:
+    games = [
+        {"label": label, "overrides": overrides, "seed": seed, "result": play(overrides, seed)}
+        for label, overrides in CASES
+        for seed in SEEDS
+    ]
+    DATA.parent.mkdir(exist_ok=True)
+    DATA.write_text(json.dumps(games, indent=1) + "\n")
+    print(f"{len(games)} reference games -> {DATA}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
