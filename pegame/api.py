@@ -69,11 +69,17 @@ class PursuerObservation:
 
 @dataclass(frozen=True)
 class EvaderObservation:
-    """What the evader strategy is given: time (s), its own pose and the pursuer's pose."""
+    """What the evader strategy is given: time (s), its own pose and the pursuer's pose.
+
+    pursuer_region: the pursuer's visibility region at this tick, as the game computed it
+    from the pursuer's pose, the map and the camera (which the evader knows too, so this
+    only saves it the work); None when the game did not compute it.
+    """
 
     time: float
     pose: Pose
     pursuer: Pose
+    pursuer_region: VisibilityRegion | None = None
 
 
 @dataclass(frozen=True)
@@ -263,7 +269,11 @@ class Recorder(Plugin):
 
     @abstractmethod
     def finish(self, result: dict[str, Any]) -> None:
-        """Close the recording; ``result`` is the game's result dict."""
+        """Close the recording of a game that ended; ``result`` is the game's result dict."""
+
+    def abort(self, error: BaseException) -> None:
+        """Close the recording of a game that raised ``error`` (the game loop calls this
+        instead of :meth:`finish`); the recording should say that the game failed."""
 
 
 #: entry-point group suffix and interface, per config group

@@ -175,7 +175,7 @@ class Game:
                 else:
                     belief = estimator.update(dt, p_pose, detection, visible)
                 seen = body_in_view(grid, camera, p_pose, (e_pose.x, e_pose.y), evader_radius)
-                e_obs = EvaderObservation(time, e_pose, p_pose)
+                e_obs = EvaderObservation(time, e_pose, p_pose, visible)
                 p_obs = PursuerObservation(time, p_pose, detection, belief, visible)
                 if step % decide_every == 0:
                     e_plan = evader.decide(e_obs)
@@ -190,6 +190,10 @@ class Game:
                                   seen, commands, (p_plan, e_plan)))
                 sim.step(commands[0], commands[1], dt)
             result = self._result(ticks, metrics)
+        except BaseException as error:
+            recorder.abort(error)
+            raise
+        else:
             recorder.finish(result)
         finally:
             sim.close()
