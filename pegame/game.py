@@ -1,14 +1,15 @@
-"""The game loop and its result (paper, Sec. "Simulation based validation").
+"""A game from a composed config: its scenario, its plugins, its play and its result
+(paper, Sec. "Simulation based validation").
 
 Protocol: both agents spawn at random free poses (seeded) with the evader in the
-pursuer's view; the game lasts ``game.t_max`` seconds. At every control tick (period
-1 / ``game.control_hz``) the simulator renders the pursuer's camera, the detector looks
-for the evader, the estimator updates its belief from the detection and the pursuer's
-visibility region; at every decision tick (1 / ``game.decision_hz``) the evader decides
-first, then the pursuer; both then act concurrently at control rate. The pursuer learns
-about the evader only through its detector; the evader is told the pursuer's pose. The
-ground truth ``in_view`` of every tick is whether any part of the evader's body is in the
-pursuer's view (:func:`pegame.visibility.body_in_view`).
+pursuer's view; the game lasts ``game.t_max`` seconds of control ticks played by
+:class:`pegame.loop.TickLoop` (the order of a tick is written there, once). The pursuer
+learns about the evader only through its detector; the evader is told the pursuer's pose.
+
+A :class:`Scenario` is the config validated once: the map, the bodies, the camera, the
+plugin classes and their configs. ``scenario.game(seed)`` builds one :class:`Game`: every
+component gets its own generator from the master seed (one SeedSequence stream per
+component, in :data:`STREAMS` order), so the same scenario and seed give the same game.
 """
 
 from __future__ import annotations
@@ -27,21 +28,22 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from pegame import registry
-from pegame.api import Context, EvaderObservation, PursuerObservation, Tick
-from pegame.types import Body, Camera, Plan, Pose
+from pegame.api import INTERFACES, Context
 from pegame.config import EnvConfig, GameConfig, resolve_map_path, typed
 from pegame.errors import SpawnError
 from pegame.files import write_atomic
-from pegame.visibility import VisibilityRegion, body_in_view, in_view, visibility_region
 from pegame.grid import OccupancyGrid, load_map
+from pegame.loop import TickLoop
 from pegame.metrics import TrackingMetrics
 from pegame.navigation import Planner
+from pegame.types import Body, Camera, Pose
+from pegame.visibility import in_view, visibility_region
 
 log = logging.getLogger(__name__)
 
-#: the order in which components draw their generators from the master seed; append only
-STREAMS = ("spawn", "sim", "detector", "estimator", "pursuer", "evader", "recorder")
-PLUGIN_GROUPS = ("sim", "detector", "estimator", "pursuer", "evader", "recorder")
+#: the order in which components draw their generators from the master seed: the spawn,
+#: then the plugin kinds in api.INTERFACES order (append only: games depend on it)
+STREAMS = ("spawn", *INTERFACES)
 
 
 def cached_map(path: Path) -> OccupancyGrid:
@@ -111,96 +113,95 @@ TRAJECTORY_HEADER = (
 )
 
 
-class Game:
-    """One game, built from a composed config (see :func:`build`)."""
+class Scenario:
+    """A composed config validated once: settings, camera, map, plugin classes and their
+    configs, and the game context. Every bad value or name raises a PegameError here,
+    before any game is played. ``base_dir``: where relative map paths are found."""
 
     def __init__(self, cfg: DictConfig, base_dir: str | Path | None = None) -> None:
         self.settings: GameConfig = typed(cfg.game, GameConfig, "game")
-        self.camera: Camera = typed(cfg.camera, Camera, "camera")
+        camera: Camera = typed(cfg.camera, Camera, "camera")
         env: EnvConfig = typed(cfg.env, EnvConfig, "env")
         self.env_name = env.name
         grid = cached_map(resolve_map_path(env.map, base_dir))
-        self.names = {group: str(cfg[group].name) for group in PLUGIN_GROUPS}
-        classes = {group: registry.load(group, self.names[group]) for group in PLUGIN_GROUPS}
-        configs = {
-            group: registry.make_config(
-                group, classes[group], {k: v for k, v in cfg[group].items() if k != "name"}
+        self.names = {kind: str(cfg[kind].name) for kind in INTERFACES}
+        self.classes = {kind: registry.load(kind, self.names[kind]) for kind in INTERFACES}
+        self.configs = {
+            kind: registry.make_config(
+                kind, self.classes[kind], {k: v for k, v in cfg[kind].items() if k != "name"}
             )
-            for group in PLUGIN_GROUPS
+            for kind in INTERFACES
         }
-        evader_cfg, pursuer_cfg = configs["evader"], configs["pursuer"]
+        evader_cfg, pursuer_cfg = self.configs["evader"], self.configs["pursuer"]
         self.context = Context(
             grid=grid,
             pursuer=Body(pursuer_cfg.radius, self.settings.speed_ratio * evader_cfg.v_max, pursuer_cfg.w_max),
             evader=Body(evader_cfg.radius, evader_cfg.v_max, evader_cfg.w_max),
-            camera=self.camera,
+            camera=camera,
             control_dt=1.0 / self.settings.control_hz,
             decision_dt=1.0 / self.settings.decision_hz,
         )
-        streams = dict(zip(STREAMS, np.random.SeedSequence(self.settings.seed).spawn(len(STREAMS))))
+        self.config = OmegaConf.to_container(cfg, resolve=True)
+        self.ticks = int(round(self.settings.t_max * self.settings.control_hz))
+        self.decide_every = max(1, int(round(self.settings.control_hz / self.settings.decision_hz)))
+
+    def game(self, seed: int) -> Game:
+        """The game of this scenario with master seed ``seed``."""
+        return Game(self, seed)
+
+
+class Game:
+    """One game: a scenario's plugins (by kind) built with the generators of ``seed``.
+
+    source: a :class:`Scenario`, or a composed config to build one from (with
+    ``base_dir``); seed: the master seed, by default the config's ``game.seed``.
+    """
+
+    def __init__(self, source: Scenario | DictConfig, seed: int | None = None,
+                 base_dir: str | Path | None = None) -> None:
+        scenario = source if isinstance(source, Scenario) else Scenario(source, base_dir)
+        self.scenario = scenario
+        self.seed = scenario.settings.seed if seed is None else seed
+        self.context = scenario.context
+        streams = dict(zip(STREAMS, np.random.SeedSequence(self.seed).spawn(len(STREAMS))))
         self.spawn_rng = np.random.default_rng(streams["spawn"])
         self.plugins = {
-            group: classes[group](configs[group], self.context, np.random.default_rng(streams[group]))
-            for group in PLUGIN_GROUPS
+            kind: scenario.classes[kind](scenario.configs[kind], self.context, np.random.default_rng(streams[kind]))
+            for kind in INTERFACES
         }
-        self.config = OmegaConf.to_container(cfg, resolve=True)
+
+    def start(self, external: tuple[str, ...] = (), estimate: bool = True) -> TickLoop:
+        """Spawn both agents and return the game's tick loop at tick 0 (see TickLoop)."""
+        loop = TickLoop(self.plugins, self.context, self.scenario.ticks, self.scenario.decide_every,
+                        external, estimate)
+        loop.start(*spawn(self.context, self.spawn_rng))
+        return loop
 
     def play(self, out_dir: str | Path, recording_name: str = "game") -> Outcome:
         """Play the game; the recorder (if any) writes ``recording_name`` into ``out_dir``."""
-        sim, detector, estimator = self.plugins["sim"], self.plugins["detector"], self.plugins["estimator"]
-        pursuer, evader, recorder = self.plugins["pursuer"], self.plugins["evader"], self.plugins["recorder"]
-        grid, camera, dt = self.context.grid, self.camera, self.context.control_dt
-        evader_radius = self.context.evader.radius
-        ticks = int(round(self.settings.t_max * self.settings.control_hz))
-        decide_every = max(1, int(round(self.settings.control_hz / self.settings.decision_hz)))
-
-        start_p, start_e = spawn(self.context, self.spawn_rng)
-        sim.reset(start_p, start_e)
-        detector.reset()
-        pursuer.reset(start_p)
-        evader.reset(start_e)
-        recorder.start(str(out_dir), recording_name, self.config)
-        metrics = TrackingMetrics(dt)
-        trajectory: list[tuple] = []
-        p_plan = e_plan = Plan()
+        recorder = self.plugins["recorder"]
+        config = {**self.scenario.config, "game": {**self.scenario.config["game"], "seed": self.seed}}
         try:
-            for step in range(ticks):
-                time = step * dt
-                p_pose, e_pose = sim.poses
-                frame = sim.sense(time)
-                detection = detector.detect(frame)
-                visible = VisibilityRegion(grid, p_pose, camera)
-                if step == 0:
-                    belief = estimator.reset(p_pose, detection, visible)
-                else:
-                    belief = estimator.update(dt, p_pose, detection, visible)
-                seen = body_in_view(grid, camera, p_pose, (e_pose.x, e_pose.y), evader_radius)
-                e_obs = EvaderObservation(time, e_pose, p_pose, visible)
-                p_obs = PursuerObservation(time, p_pose, detection, belief, visible)
-                if step % decide_every == 0:
-                    e_plan = evader.decide(e_obs)
-                    p_plan = pursuer.decide(p_obs)
-                commands = (pursuer.control(p_obs), evader.control(e_obs))
-                metrics.add(p_pose, e_pose, detection is not None, seen, belief)
-                trajectory.append(
-                    (step, round(time, 6), p_pose.x, p_pose.y, p_pose.theta,
-                     e_pose.x, e_pose.y, e_pose.theta, int(detection is not None), int(seen))
-                )
-                recorder.log(Tick(step, time, p_pose, e_pose, frame, detection, belief, visible,
-                                  seen, commands, (p_plan, e_plan)))
-                sim.step(commands[0], commands[1], dt)
-            result = self._result(ticks, metrics)
-        except BaseException as error:
-            recorder.abort(error)
-            raise
-        else:
+            loop = self.start()
+            recorder.start(str(out_dir), recording_name, config)
+            trajectory: list[tuple] = []
+            try:
+                while not loop.done:
+                    t = loop.advance()
+                    p, e = t.pursuer, t.evader
+                    trajectory.append((t.step, round(t.time, 6), p.x, p.y, p.theta, e.x, e.y, e.theta,
+                                       int(t.detection is not None), int(t.in_view)))
+                result = self._result(loop.metrics)
+            except BaseException as error:
+                recorder.abort(error)
+                raise
             recorder.finish(result)
         finally:
-            sim.close()
+            self.plugins["sim"].close()
         return Outcome(result, trajectory)
 
-    def _result(self, ticks: int, metrics: TrackingMetrics) -> dict[str, Any]:
-        s, names = self.settings, self.names
+    def _result(self, metrics: TrackingMetrics) -> dict[str, Any]:
+        s, names = self.scenario.settings, self.scenario.names
         return {
             "pairing": pairing(names["pursuer"], names["evader"]),
             "pursuer": names["pursuer"],
@@ -208,13 +209,13 @@ class Game:
             "estimator": names["estimator"],
             "detector": names["detector"],
             "sim": names["sim"],
-            "map": self.env_name,
-            "seed": s.seed,
+            "map": self.scenario.env_name,
+            "seed": self.seed,
             "speed_ratio": s.speed_ratio,
             "t_max": s.t_max,
             "control_hz": s.control_hz,
             "decision_hz": s.decision_hz,
-            "ticks": ticks,
+            "ticks": self.scenario.ticks,
             **metrics.summary(),
         }
 

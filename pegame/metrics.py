@@ -48,12 +48,14 @@ class TrackingMetrics:
         self.estimate_error: list[float] = []  # NaN where detected or no estimate
         self.n_eff: list[float] = []
         self.resamplings = 0
+        self.detected_ticks = 0
 
     def add(self, pursuer: Pose, evader: Pose, detected: bool, in_view: bool, belief: Belief) -> None:
         """Record one control tick: true poses, detection, ground-truth visibility, belief."""
         self.pursuer.append((pursuer.x, pursuer.y))
         self.evader.append((evader.x, evader.y))
         self.detected.append(detected)
+        self.detected_ticks += detected
         self.in_view.append(in_view)
         error = math.nan
         if not detected and belief.mean is not None:
@@ -66,7 +68,7 @@ class TrackingMetrics:
     @property
     def tracking_rate(self) -> float:
         """Fraction of ticks so far with the evader detected."""
-        return float(np.mean(self.detected)) if self.detected else 0.0
+        return self.detected_ticks / len(self.detected) if self.detected else 0.0
 
     def summary(self) -> dict[str, float | int | None]:
         """The game's measures: rates in [0, 1], times in s, distances in m."""

@@ -35,12 +35,12 @@ def rollout(env, seed: int, action_seed: int = 0) -> list:
     """(observations, rewards, poses) of every step of one seeded game with random actions."""
     rng = np.random.default_rng(action_seed)
     obs, _ = env.reset(seed=seed)
-    match = env.episode.match
-    steps = [(obs, None, (match.pursuer, match.evader))]
+    loop = env.game.loop
+    steps = [(obs, None, (loop.pursuer, loop.evader))]
     while env.agents:
         actions = {agent: rng.uniform(-1, 1, 2).astype(np.float32) for agent in env.agents}
         obs, rewards, _, _, _ = env.step(actions)
-        steps.append((obs, rewards, (match.pursuer, match.evader)))
+        steps.append((obs, rewards, (loop.pursuer, loop.evader)))
     return steps
 
 
@@ -118,11 +118,11 @@ def test_bad_seed_is_a_value_error(par_env, seed):
 )
 def test_bad_actions_raise_and_leave_the_game_untouched(par_env, action, message):
     par_env.reset(seed=0)
-    match = par_env.episode.match
-    before = (match.step, match.pursuer, match.evader)
+    loop = par_env.game.loop
+    before = (loop.step, loop.pursuer, loop.evader)
     with pytest.raises(ValueError, match=message):
         par_env.step({"pursuer": np.zeros(2, np.float32), "evader": action})
-    assert (match.step, match.pursuer, match.evader) == before
+    assert (loop.step, loop.pursuer, loop.evader) == before
 
 
 def test_missing_or_unknown_agents_raise(par_env):
@@ -148,7 +148,7 @@ def rollout_with(env, action: np.ndarray) -> list[tuple[Pose, Pose]]:
     poses = []
     while env.agents:
         env.step({"pursuer": action, "evader": action})
-        poses.append((env.episode.match.pursuer, env.episode.match.evader))
+        poses.append((env.game.loop.pursuer, env.game.loop.evader))
     return poses
 
 
@@ -166,13 +166,13 @@ def test_zero_sum_rewards_count_detections_and_info_ends_with_the_metrics(par_en
     rewards = [r for _, r, _ in steps[1:]]
     assert all(r["pursuer"] == -r["evader"] in (0.0, 1.0) for r in rewards)
     assert len(rewards) == 30  # 3 s at 10 Hz, one control tick per step
-    match = par_env.episode.match
-    summary = match.metrics.summary()
-    info = par_env.episode.info()
+    loop = par_env.game.loop
+    summary = loop.metrics.summary()
+    info = par_env.game.info()
     assert info["metrics"] == summary and info["tracking_rate"] == pytest.approx(summary["tracking_rate"])
     # Rewards count detections at ticks 1..30, the measure ticks 0..29.
-    first = match.metrics.detected[0]
-    assert sum(r["pursuer"] for r in rewards) == 30 * summary["tracking_rate"] - first + (match.detection is not None)
+    first = loop.metrics.detected[0]
+    assert sum(r["pursuer"] for r in rewards) == 30 * summary["tracking_rate"] - first + (loop.detection is not None)
 
 
 def test_decision_period_holds_each_action_for_whole_ticks():
@@ -233,10 +233,10 @@ def test_observations_lie_in_their_space_and_start_with_a_detection(par_env):
 
 def test_pose_features_are_normalised_by_the_map_extent(par_env):
     par_env.reset(seed=4)
-    match = par_env.episode.match
-    p = par_env.episode.observations()["pursuer"]
-    x0, x1, y0, y1 = match.context.grid.extent
-    pose = match.pursuer
+    loop = par_env.game.loop
+    p = par_env.game.observations()["pursuer"]
+    x0, x1, y0, y1 = loop.context.grid.extent
+    pose = loop.pursuer
     assert p[0] == pytest.approx(2 * (pose.x - x0) / (x1 - x0) - 1, abs=1e-6)
     assert p[1] == pytest.approx(2 * (pose.y - y0) / (y1 - y0) - 1, abs=1e-6)
     assert p[2:4] == pytest.approx([math.cos(pose.theta), math.sin(pose.theta)], abs=1e-6)

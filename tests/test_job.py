@@ -45,7 +45,7 @@ def test_a_failing_game_is_recorded_and_the_job_goes_on(tmp_path, monkeypatch):
     real_play = job.Game.play
 
     def flaky(self, out_dir, recording_name="game"):
-        if self.settings.seed == 1:
+        if self.seed == 1:
             raise RuntimeError("simulated crash")
         return real_play(self, out_dir, recording_name)
 

@@ -62,9 +62,9 @@ def env_rollout(env_id: str, policy, opponent: str, seed: int = 5, **settings) -
 
     env = gymnasium.make(env_id, overrides=SHORT, opponent=opponent, **settings).unwrapped
     obs, _ = env.reset(seed=seed)
-    match, rows, truncated = env.episode.match, [], False
+    loop, rows, truncated = env.game.loop, [], False
     while not truncated:
-        rows.append((*vars(match.pursuer).values(), *vars(match.evader).values()))
+        rows.append((*vars(loop.pursuer).values(), *vars(loop.evader).values()))
         obs, _, _, truncated, _ = env.step(np.clip(policy(obs), -1.0, 1.0))
     return np.array(rows)
 

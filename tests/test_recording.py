@@ -131,7 +131,7 @@ def test_fov_wedge_is_placed_at_the_pursuer_pose_every_step(played):
         assert qx == qy == 0.0
         c, s = math.cos(angle), math.sin(angle)
         placed = np.column_stack([tx + c * strips[:, 0] - s * strips[:, 1], ty + s * strips[:, 0] + c * strips[:, 1]])
-        np.testing.assert_allclose(placed, fov_wedge(game.camera, pose, n=16), atol=1e-5)
+        np.testing.assert_allclose(placed, fov_wedge(game.context.camera, pose, n=16), atol=1e-5)
 
 
 def test_trajectories_are_chained_segments_through_the_agent_poses(played):
@@ -165,8 +165,8 @@ def test_config_and_result_are_recording_properties_with_their_types(played):
             batch = chunk.to_record_batch()
             found.update({(chunk.entity_path, name): batch.column(name).to_pylist()[0][0]
                           for name in batch.schema.names if name != "rerun.controls.RowId"})
-    assert found[("/__properties/config", "game.seed")] == game.config["game"]["seed"]
-    assert found[("/__properties/config", "camera.fov")] == pytest.approx(game.camera.fov)
+    assert found[("/__properties/config", "game.seed")] == game.seed
+    assert found[("/__properties/config", "camera.fov")] == pytest.approx(game.context.camera.fov)
     assert found[("/__properties/result", "pairing")] == outcome.result["pairing"]
     assert found[("/__properties/result", "tracking_rate")] == outcome.result["tracking_rate"]
     assert type(found[("/__properties/config", "game.seed")]) is int

@@ -31,7 +31,7 @@ def bench_steps_per_second(
         env.reset(seed=seed + resets)
         resetting += time.perf_counter() - start
         resets += 1
-        actions = rng.uniform(-1.0, 1.0, (env.episode.steps, 2, 2)).astype(np.float32)
+        actions = rng.uniform(-1.0, 1.0, (env.game.steps, 2, 2)).astype(np.float32)
         start = time.perf_counter()
         for pair in actions:
             env.step({"pursuer": pair[0], "evader": pair[1]})

@@ -1,5 +1,5 @@
 """The environments' shared core: observations, actions, rewards and infos of one or two
-learning roles around a :class:`pegame.envs.match.Match`.
+learning roles in games played by the one tick loop (:class:`pegame.loop.TickLoop`).
 
 A step applies the learners' actions for ``ticks_per_action`` control ticks (the
 decision period) while the other role, if any, plays its strategy. Reward: the pursuer
@@ -8,7 +8,7 @@ evader, the evader the negative (zero-sum). The game ends after ``game.t_max`` s
 last step is a truncation (there is no terminal state); a last step may be shorter when
 t_max is not a whole number of decision periods.
 
-Infos: ``seed`` (the episode's master seed; ``python -m pegame game.seed=<seed>`` with
+Infos: ``seed`` (the game's master seed; ``python -m pegame game.seed=<seed>`` with
 the same strategies replays it) after reset; ``time`` (s) and ``tracking_rate`` (the
 fraction of the ticks played so far with the evader detected, as in the game's result)
 after every step; and at the end ``metrics``, the game's
@@ -23,9 +23,10 @@ import numpy as np
 from omegaconf import DictConfig
 
 from pegame.envs.actions import to_velocity
-from pegame.envs.match import Match
 from pegame.envs.observations import EvaderFeatures, PursuerFeatures
 from pegame.envs.settings import EnvSettings
+from pegame.game import Scenario
+from pegame.loop import TickLoop
 
 
 def check_seed(seed: int | None) -> int | None:
@@ -35,19 +36,22 @@ def check_seed(seed: int | None) -> int | None:
     return seed
 
 
-def episode_seed(seed: int | None, rng: np.random.Generator) -> int:
+def game_seed(seed: int | None, rng: np.random.Generator) -> int:
     """``seed`` itself when given (checked), else a fresh one drawn from ``rng``."""
     return int(rng.integers(2**63 - 1)) if check_seed(seed) is None else int(seed)
 
 
-class Episode:
-    """The learning ``roles`` (a subset of ('pursuer', 'evader')) in games of ``cfg``."""
+class EnvGame:
+    """The learning ``roles`` (a subset of ('pursuer', 'evader')) in games of ``cfg``, one
+    game at a time: ``reset(seed)`` builds the scenario's game with that master seed (the
+    game ``python -m pegame game.seed=<seed>`` plays) and ``step`` drives its tick loop,
+    the learners' roles commanded from outside."""
 
     def __init__(self, cfg: DictConfig, settings: EnvSettings, roles: Sequence[str]) -> None:
         self.settings = settings
         self.roles = tuple(roles)
-        self.match = Match(cfg, self.roles, belief=settings.belief)
-        context = self.match.context
+        self.scenario = Scenario(cfg)
+        context = self.scenario.context
         self.ticks_per_action = settings.ticks_per_action(context.control_dt)
         self.features = {
             "pursuer": PursuerFeatures(context, settings.observation),
@@ -55,16 +59,18 @@ class Episode:
         }
         self.bodies = {"pursuer": context.pursuer, "evader": context.evader}
         self.seed: int | None = None
+        self.loop: TickLoop | None = None
 
     @property
     def steps(self) -> int:
-        """Steps in one episode."""
-        return -(-self.match.ticks // self.ticks_per_action)
+        """Steps in one game."""
+        return -(-self.scenario.ticks // self.ticks_per_action)
 
     def reset(self, seed: int) -> dict[str, np.ndarray]:
-        """Start an episode with master seed ``seed``; the learners' first observations."""
+        """Start a game with master seed ``seed``; the learners' first observations."""
+        self.close()
         self.seed = seed
-        self.match.start(seed)
+        self.loop = self.scenario.game(seed).start(self.roles, estimate=self.settings.belief)
         for role in self.roles:
             self.features[role].reset()
         self._remember()
@@ -76,37 +82,39 @@ class Episode:
         Returns the new observations, the pursuer's reward (the evader's is its negative)
         and whether the game is over. Every action is checked before anything moves.
         """
-        if self.seed is None or self.match.done:
+        loop = self.loop
+        if loop is None or loop.done:
             raise RuntimeError("No game in progress: call reset() before step().")
         commands = self._commands(actions)
         detections = 0
         for _ in range(self.ticks_per_action):
-            detections += self.match.advance(commands["pursuer"], commands["evader"])
+            loop.advance(commands)
+            detections += loop.detection is not None
             self._remember()
-            if self.match.done:
+            if loop.done:
                 break
-        return self.observations(), float(detections), self.match.done
+        return self.observations(), float(detections), loop.done
 
     def observations(self) -> dict[str, np.ndarray]:
         """Each learner's observation at the current tick (new arrays)."""
-        m, out = self.match, {}
+        loop, out = self.loop, {}
         if "pursuer" in self.roles:
-            out["pursuer"] = self.features["pursuer"].build(m.time, m.pursuer, m.belief)
+            out["pursuer"] = self.features["pursuer"].build(loop.time, loop.pursuer, loop.belief)
         if "evader" in self.roles:
-            out["evader"] = self.features["evader"].build(m.evader, m.pursuer)
+            out["evader"] = self.features["evader"].build(loop.evader, loop.pursuer)
         return out
 
     def info(self) -> dict:
         """The step's info (see the module docstring); a new dict each call."""
-        m = self.match
-        info = {"time": m.time, "tracking_rate": m.tracking_rate}
-        if m.done:
-            info["metrics"] = m.metrics.summary()
+        loop = self.loop
+        info = {"time": loop.time, "tracking_rate": loop.metrics.tracking_rate}
+        if loop.done:
+            info["metrics"] = loop.metrics.summary()
         return info
 
     def _remember(self) -> None:
         if "pursuer" in self.roles:
-            self.features["pursuer"].remember(self.match.time, self.match.detection)
+            self.features["pursuer"].remember(self.loop.time, self.loop.detection)
 
     def _commands(self, actions: Mapping[str, object]) -> dict:
         if not isinstance(actions, Mapping):
@@ -118,10 +126,13 @@ class Episode:
                 f"actions must have exactly the agents {list(self.roles)}; "
                 f"missing {missing}, unexpected {unknown}."
             )
-        commands = {"pursuer": None, "evader": None}
-        for role in self.roles:
-            commands[role] = to_velocity(actions[role], self.bodies[role], self.settings.clip_actions, f"{role} action")
-        return commands
+        return {
+            role: to_velocity(actions[role], self.bodies[role], self.settings.clip_actions, f"{role} action")
+            for role in self.roles
+        }
 
     def close(self) -> None:
-        self.match.close()
+        """Release the current game's simulator."""
+        if self.loop is not None:
+            self.loop.sim.close()
+            self.loop = None

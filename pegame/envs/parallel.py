@@ -17,8 +17,8 @@ from gymnasium import spaces
 from omegaconf import DictConfig
 from pettingzoo import ParallelEnv
 
-from pegame.envs.core import Episode, check_seed, episode_seed
-from pegame.envs.match import ROLES
+from pegame.envs.core import EnvGame, check_seed, game_seed
+from pegame.loop import ROLES
 from pegame.envs.settings import env_config, env_settings
 
 
@@ -37,10 +37,10 @@ class PursuitEvasionParallelEnv(ParallelEnv):
 
     def __init__(self, config: DictConfig | None = None, overrides: Sequence[str] = (), **settings) -> None:
         self.settings = env_settings(**settings)
-        self.episode = Episode(env_config(config, overrides), self.settings, ROLES)
+        self.game = EnvGame(env_config(config, overrides), self.settings, ROLES)
         self.possible_agents = list(ROLES)
         self.agents: list[str] = []
-        features = self.episode.features
+        features = self.game.features
         self.layouts = {role: features[role].layout for role in ROLES}
         self.observation_spaces = {
             role: spaces.Box(features[role].low, features[role].high, dtype=np.float32) for role in ROLES
@@ -59,21 +59,21 @@ class PursuitEvasionParallelEnv(ParallelEnv):
         later seedless resets draw their seeds from it; never seeded, seeds are random."""
         if seed is not None or self._np_random is None:
             self._np_random = np.random.default_rng(check_seed(seed))
-        obs = self.episode.reset(episode_seed(seed, self._np_random))
+        obs = self.game.reset(game_seed(seed, self._np_random))
         self.agents = list(ROLES)
-        return obs, {role: {"seed": self.episode.seed} for role in ROLES}
+        return obs, {role: {"seed": self.game.seed} for role in ROLES}
 
     def step(self, actions: dict[str, np.ndarray]):
         """One decision period with both agents' actions (ValueError for a bad one)."""
-        obs, reward, done = self.episode.step(actions)
+        obs, reward, done = self.game.step(actions)
         rewards = {"pursuer": reward, "evader": -reward}
-        infos = {role: self.episode.info() for role in ROLES}
+        infos = {role: self.game.info() for role in ROLES}
         if done:
             self.agents = []
         return obs, rewards, dict.fromkeys(ROLES, False), dict.fromkeys(ROLES, done), infos
 
     def close(self) -> None:
-        self.episode.close()
+        self.game.close()
 
 
 def parallel_env(config: DictConfig | None = None, overrides: Sequence[str] = (), **settings) -> PursuitEvasionParallelEnv:

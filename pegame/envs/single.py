@@ -17,7 +17,7 @@ import numpy as np
 from gymnasium import spaces
 from omegaconf import DictConfig
 
-from pegame.envs.core import Episode, check_seed, episode_seed
+from pegame.envs.core import EnvGame, check_seed, game_seed
 from pegame.envs.settings import env_config, env_settings
 
 PURSUIT_ID = "pegame/Pursuit-v0"
@@ -45,9 +45,9 @@ class _SingleAgentEnv(gymnasium.Env):
         self.settings = env_settings(**settings)
         other = "evader" if self.role == "pursuer" else "pursuer"
         cfg = env_config(config, overrides, {other: opponent} if opponent is not None else None)
-        self.episode = Episode(cfg, self.settings, (self.role,))
+        self.game = EnvGame(cfg, self.settings, (self.role,))
         self.opponent = str(cfg[other].name)
-        features = self.episode.features[self.role]
+        features = self.game.features[self.role]
         self.layout = features.layout
         self.observation_space = spaces.Box(features.low, features.high, dtype=np.float32)
         self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
@@ -57,16 +57,16 @@ class _SingleAgentEnv(gymnasium.Env):
         """Start a game; ``seed`` is the game's master seed (later seedless resets draw
         theirs from it); never seeded, seeds are random."""
         super().reset(seed=check_seed(seed))
-        obs = self.episode.reset(episode_seed(seed, self.np_random))
-        return obs[self.role], {"seed": self.episode.seed}
+        obs = self.game.reset(game_seed(seed, self.np_random))
+        return obs[self.role], {"seed": self.game.seed}
 
     def step(self, action):
         """One decision period (ValueError for a bad action)."""
-        obs, reward, done = self.episode.step({self.role: action})
-        return obs[self.role], self._sign * reward, False, done, self.episode.info()
+        obs, reward, done = self.game.step({self.role: action})
+        return obs[self.role], self._sign * reward, False, done, self.game.info()
 
     def close(self) -> None:
-        self.episode.close()
+        self.game.close()
 
 
 class PursuitEnv(_SingleAgentEnv):
