@@ -55,8 +55,8 @@ class PursuerObservation:
     """What the pursuer strategy is given at each tick.
 
     time (s); pose: its own true pose (the paper assumes a localised robot); detection of
-    the evader this tick, or None; belief: the estimator's current belief; visible: the
-    pursuer's own visibility region this tick (``visible.mask`` is a bool (H, W) mask over
+    the evader this tick, or None; belief: the estimator's current belief; region: the
+    pursuer's own visibility region this tick (``region.mask`` is a bool (H, W) mask over
     the grid, computed when first read).
     """
 
@@ -64,7 +64,7 @@ class PursuerObservation:
     pose: Pose
     detection: Detection | None
     belief: Belief
-    visible: VisibilityRegion
+    region: VisibilityRegion
 
 
 @dataclass(frozen=True)
@@ -103,7 +103,7 @@ class Tick:
     """Everything that happened at one control tick, as the recorder receives it.
 
     step: control tick index; time (s); pursuer, evader: true poses; frame: the sensor
-    frame; detection or None; belief; visible: the pursuer's visibility region;
+    frame; detection or None; belief; region: the pursuer's visibility region (None when not computed);
     in_view: ground-truth visibility of the evader; commands: (pursuer, evader) velocities
     applied after this tick; plans: the latest (pursuer, evader) plans.
     """
@@ -115,7 +115,7 @@ class Tick:
     frame: SensorFrame
     detection: Detection | None
     belief: Belief
-    visible: VisibilityRegion
+    region: VisibilityRegion | None
     in_view: bool
     commands: tuple[Velocity, Velocity]
     plans: tuple[Plan, Plan]
@@ -187,16 +187,16 @@ class Estimator(Plugin):
     """
 
     @abstractmethod
-    def reset(self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion) -> Belief:
+    def reset(self, pursuer: Pose, detection: Detection | None, region: VisibilityRegion) -> Belief:
         """Start a new game; the evader is in view at the start (the paper's protocol)."""
 
     @abstractmethod
     def update(
-        self, dt: float, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
+        self, dt: float, pursuer: Pose, detection: Detection | None, region: VisibilityRegion
     ) -> Belief:
         """Predict dt seconds (s) ahead and correct with this tick's detection (or its
-        absence) and the pursuer's visibility region (``visible.mask`` is a bool (H, W) mask
-        over the grid; ``visible.holds(cells)`` answers for a few cells, at a fraction of
+        absence) and the pursuer's visibility region (``region.mask`` is a bool (H, W) mask
+        over the grid; ``region.holds(cells)`` answers for a few cells, at a fraction of
         the cost)."""
 
 
