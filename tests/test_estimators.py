@@ -344,7 +344,8 @@ def test_vanished_weights_reinitialise_outside_the_view(caplog):
     assert np.all(belief.weights == 1.0 / 2000)
     assert np.all(on_free(grid, belief.particles))
     assert not np.any(cell_values(grid, belief.particles, view.mask))
-    everywhere = VisibilityRegion.given(np.ones((grid.height, grid.width), dtype=bool))  # no free cell outside it
+    # A region over the whole grid: no free cell is left outside it.
+    everywhere = VisibilityRegion.given(np.ones((grid.height, grid.width), dtype=bool))
     pf.reset(PURSUER, detection(1.5, 2.0), everywhere)
     belief = pf.update(DT, PURSUER, None, everywhere)
     assert np.all(on_free(grid, belief.particles)) and np.all(np.isfinite(belief.weights))

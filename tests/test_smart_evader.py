@@ -235,7 +235,8 @@ def test_the_evader_escapes_the_region_it_is_given():
     gives the decision of an evader built with that camera."""
     grid, pursuer, me = random_scene(3, 40, 8)
     wide = Camera(fov=2.5, near=0.1, far=3.0, angle_step=0.004, distance_step=0.05)
-    told = make_evader(grid).decide(EvaderObservation(0.0, me, pursuer, VisibilityRegion(grid, pursuer, wide)))
+    wide_region = VisibilityRegion(grid, pursuer, wide)
+    told = make_evader(grid).decide(EvaderObservation(0.0, me, pursuer, wide_region))
     built = make_evader(grid, camera=wide).decide(EvaderObservation(0.0, me, pursuer))
     own = make_evader(grid).decide(EvaderObservation(0.0, me, pursuer))
     assert told.goal == built.goal and told.info["escape_cost"] == built.info["escape_cost"]

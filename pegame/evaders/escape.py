@@ -284,7 +284,8 @@ class EscapeSearch:
     ) -> None:
         self.grid, self.camera = grid, camera
         self.planner, self.pursuer_planner = planner, pursuer_planner
-        self.distance, self.candidate_stride, self.hide_margin = distance, candidate_stride, hide_margin
+        self.distance, self.candidate_stride = distance, candidate_stride
+        self.hide_margin = hide_margin
         rows, cols = np.indices(grid.data.shape)
         #: cell centres (m, map frame) by flat row-major cell index, shape (H * W, 2)
         self.centres = np.column_stack([v.ravel() for v in grid.cell_to_world(rows, cols)])
