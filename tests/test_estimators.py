@@ -7,7 +7,6 @@ import math
 from dataclasses import fields
 from pathlib import Path
 
-import filterpy.monte_carlo.resampling as filterpy_resampling
 import numpy as np
 import pytest
 import yaml
@@ -19,16 +18,8 @@ from pegame.errors import ConfigError
 from pegame.visibility import VisibilityRegion
 from pegame.estimators.kalman import KalmanEstimator
 from pegame.estimators.last_seen import LastSeen
-from pegame.estimators.particle_filter import (
-    RESAMPLERS,
-    ParticleFilter,
-    _invert,
-    _invert_reference,
-    _systematic,
-    _wrap_angle,
-    resample,
-    wrap,
-)
+from pegame.estimators.particle_filter import ParticleFilter, _wrap_angle, wrap
+from pegame.estimators.resampling import RESAMPLERS
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 
 CONF = Path(__file__).resolve().parents[1] / "conf" / "estimator"
@@ -88,16 +79,6 @@ def on_free(grid, particles):
     return cell_values(grid, particles, grid.free)
 
 
-class Constant:
-    """A stand-in for a Generator whose uniform draws all equal ``value``."""
-
-    def __init__(self, value):
-        self.value = value
-
-    def random(self, size=None):
-        return self.value if size is None else np.full(size, self.value)
-
-
 # --------------------------------------------------------------------------- configs
 
 
@@ -121,7 +102,7 @@ def test_config_file_matches_config_class(cls, stem):
         (ParticleFilter, "sigma", -1.0),
         (ParticleFilter, "resampler", "foo"),
         (ParticleFilter, "miss_factor", 1.5),
-        (ParticleFilter, "seen_boost", 0.5),
+        (ParticleFilter, "in_region_boost", 0.5),
         (KalmanEstimator, "measurement_std", 0.0),
         (KalmanEstimator, "accel_std", -1.0),
     ],
@@ -147,8 +128,8 @@ def test_weights_stay_normalised_over_a_long_run():
         # The target walks at up to 0.4 m/s inside the free part left of the block.
         target = np.clip(target + rng.uniform(-0.04, 0.04, 2), [0.3, 0.3], [2.7, 3.7])
         view = disc(grid, rng.uniform([0.5, 0.5], [4.5, 3.5]), 1.2)
-        seen = bool(cell_values(grid, target[None, :], view.mask)[0])
-        found = detection(*(target + rng.normal(0.0, 0.1, 2))) if seen else None
+        in_region = bool(cell_values(grid, target[None, :], view.mask)[0])
+        found = detection(*(target + rng.normal(0.0, 0.1, 2))) if in_region else None
         belief = pf.update(DT, PURSUER, found, view)
         w = belief.weights
         assert np.all(np.isfinite(w)) and np.all(w >= 0)
@@ -172,7 +153,7 @@ def test_localises_a_stationary_target():
     assert math.dist(belief.mean, target) < 0.3
 
 
-def test_negative_information_moves_mass_out_of_the_seen_region():
+def test_negative_information_moves_mass_out_of_the_region():
     grid = room()
     pf = build(ParticleFilter, grid, seed=5, rho=0.0, init_spread=0.5)
     start = pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 2.0))
@@ -184,7 +165,7 @@ def test_negative_information_moves_mass_out_of_the_seen_region():
     assert 0.1 < before < 0.9
     expected = 0.05 * before / (0.05 * before + (1.0 - before))  # miss_factor 0.05
     assert mass == pytest.approx(expected, rel=1e-9)
-    assert after.mean[0] < start.mean[0]  # the belief moves away from the seen region
+    assert after.mean[0] < start.mean[0]  # the belief moves away from the region
 
 
 def reference_weights(grid, cfg, particles, prior, found, view):
@@ -199,7 +180,7 @@ def reference_weights(grid, cfg, particles, prior, found, view):
         else:
             zx, zy = found.position
             likelihood = math.exp(-((x - zx) ** 2 + (y - zy) ** 2) / (2 * cfg.sigma**2))
-            weights.append(w * likelihood * (cfg.seen_boost if view.mask[row, col] else 1.0))
+            weights.append(w * likelihood * (cfg.in_region_boost if view.mask[row, col] else 1.0))
     return np.array(weights) / sum(weights)
 
 
@@ -257,56 +238,6 @@ def test_resampled_flag_follows_the_threshold_over_a_run(rho):
         assert not any(flags)
     if rho == 1.0:  # a detection always leaves the weights unequal, so N_eff < N
         assert all(flag for step, flag in enumerate(flags) if step % 3)
-
-
-@pytest.mark.parametrize("scheme", ["systematic", "stratified", "multinomial"])
-def test_resamplers_match_filterpy(scheme, monkeypatch):
-    weights = np.random.default_rng(9).random(200) ** 3
-    weights /= weights.sum()
-    monkeypatch.setattr(filterpy_resampling, "random", np.random.default_rng(10).random)
-    theirs = getattr(filterpy_resampling, f"{scheme}_resample")(weights)
-    ours = resample(weights, scheme, np.random.default_rng(10))
-    np.testing.assert_array_equal(ours, theirs)
-
-
-def test_residual_resampler_keeps_filterpy_deterministic_copies(monkeypatch):
-    weights = np.random.default_rng(11).random(200) ** 3
-    weights /= weights.sum()
-    monkeypatch.setattr(filterpy_resampling, "random", np.random.default_rng(12).random)
-    theirs = filterpy_resampling.residual_resample(weights)
-    ours = resample(weights, "residual", np.random.default_rng(12))
-    copies = int(np.floor(200 * weights).sum())
-    np.testing.assert_array_equal(ours[:copies], theirs[:copies])
-
-
-@pytest.mark.parametrize("scheme", RESAMPLERS)
-def test_resamplers_are_unbiased_and_skip_zero_weights(scheme):
-    weights = np.array([0.1, 0.0, 0.25, 0.3, 0.35, 0.0])
-    rng = np.random.default_rng(13)
-    counts = np.zeros(weights.size)
-    for _ in range(4000):
-        drawn = np.bincount(resample(weights, scheme, rng), minlength=weights.size)
-        if scheme == "residual":
-            assert np.all(drawn >= np.floor(weights.size * weights))
-        counts += drawn
-    assert np.all(counts[weights == 0] == 0)
-    np.testing.assert_allclose(counts / 4000, weights.size * weights, atol=0.05)
-
-
-def test_systematic_round_off_edge_case(monkeypatch):
-    """Weights summing to 1 - 1e-12 and the largest uniform draw below 1: the last
-    position lies above the cumulative sum, which runs filterpy past the end."""
-    n = 10
-    weights = np.random.default_rng(14).random(n)
-    weights *= (1.0 - 1e-12) / weights.sum()
-    top = Constant(np.nextafter(1.0, 0.0))
-    monkeypatch.setattr(filterpy_resampling, "random", top.random)
-    with pytest.raises(IndexError):
-        filterpy_resampling.systematic_resample(weights)
-    indices = resample(weights, "systematic", top)
-    assert indices.shape == (n,) and indices.min() >= 0 and indices.max() == n - 1
-    trailing = np.append(weights[:-1], 0.0)  # a zero last weight must not catch the overflow
-    assert resample(trailing, "systematic", top).max() == n - 2
 
 
 def run_side_by_side(grid, steps, seed, **params):
@@ -387,41 +318,6 @@ def test_motion_kernel_matches_the_reference_beyond_the_polynomial_range():
     assert_same_belief(fast.update(DT, PURSUER, start, view), slow.update_reference(DT, PURSUER, start, view))
 
 
-def test_inversion_kernel_matches_searchsorted():
-    rng = np.random.default_rng(29)
-    for trial in range(300):
-        n = int(rng.integers(1, 400))
-        weights = rng.random(n) ** 4
-        weights[rng.random(n) < 0.3] = 0.0  # zero weights, leading and trailing too
-        if weights.sum() == 0.0:
-            weights[rng.integers(n)] = 1.0
-        m = int(rng.integers(1, 2 * n + 2))
-        sorted_positions = (rng.random() + np.arange(m)) / m
-        edges = np.array([0.0, np.nextafter(1.0, 0.0), 1.0, weights[0] / weights.sum()])
-        for positions in (sorted_positions, rng.random(m), edges):
-            np.testing.assert_array_equal(
-                _invert(weights, positions), _invert_reference(weights, positions)
-            )
-
-
-def test_systematic_kernel_matches_searchsorted():
-    rng = np.random.default_rng(31)
-    for trial in range(400):
-        n = int(rng.integers(1, 500))
-        weights = rng.random(n) ** rng.uniform(0.5, 8.0)
-        weights[rng.random(n) < 0.3] = 0.0  # zero weights, leading and trailing too
-        if trial % 5 == 0:
-            weights = np.ones(n)  # cumulative weights i / n: positions land on them
-        if weights.sum() == 0.0:
-            weights[rng.integers(n)] = 1.0
-        weights /= weights.sum()
-        for offset in (rng.random(), 0.0, np.nextafter(1.0, 0.0), 0.5):
-            positions = (offset + np.arange(n)) / n
-            np.testing.assert_array_equal(
-                _systematic(weights, offset), _invert_reference(weights, positions)
-            )
-
-
 def test_wrap_kernel_matches_numpy():
     period = 2.0 * math.pi
     edges = [0.0, -0.0, math.pi, -math.pi, period, -period, 2 * period, -2 * period,
@@ -439,7 +335,7 @@ def test_vanished_weights_reinitialise_outside_the_view(caplog):
     grid = room()
     pf = build(ParticleFilter, grid, seed=15, miss_factor=0.0)
     pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.5))
-    view = disc(grid, (1.5, 2.0), 1.5)  # holds every particle, and the evader is not seen
+    view = disc(grid, (1.5, 2.0), 1.5)  # holds every particle, and the evader is not detected
     with caplog.at_level(logging.INFO, logger=LOGGER):
         belief = pf.update(DT, PURSUER, None, view)
     assert "vanished" in caplog.text
@@ -448,7 +344,8 @@ def test_vanished_weights_reinitialise_outside_the_view(caplog):
     assert np.all(belief.weights == 1.0 / 2000)
     assert np.all(on_free(grid, belief.particles))
     assert not np.any(cell_values(grid, belief.particles, view.mask))
-    everywhere = VisibilityRegion.given(np.ones((grid.height, grid.width), dtype=bool))  # nothing left unseen
+    # A region over the whole grid: no free cell is left outside it.
+    everywhere = VisibilityRegion.given(np.ones((grid.height, grid.width), dtype=bool))
     pf.reset(PURSUER, detection(1.5, 2.0), everywhere)
     belief = pf.update(DT, PURSUER, None, everywhere)
     assert np.all(on_free(grid, belief.particles)) and np.all(np.isfinite(belief.weights))
@@ -560,12 +457,12 @@ def test_kalman_coasts_through_a_gap_of_misses():
     noise = np.random.default_rng(24).normal(0.0, 0.1, truth.shape)
     kf.reset(PURSUER, detection(*(truth[0] + noise[0])), None)
     for k in range(1, 35):
-        seen = kf.update(DT, PURSUER, detection(*(truth[k] + noise[k])), None)
+        tracked = kf.update(DT, PURSUER, detection(*(truth[k] + noise[k])), None)
     for k in range(35, 45):
         belief = kf.update(DT, PURSUER, None, None)
     assert math.dist(belief.mean, truth[44]) < 0.2
-    assert math.dist(belief.mean, seen.mean) > 0.3  # it moved along the track
-    assert np.trace(belief.covariance) > np.trace(seen.covariance)
+    assert math.dist(belief.mean, tracked.mean) > 0.3  # it moved along the track
+    assert np.trace(belief.covariance) > np.trace(tracked.covariance)
 
 
 def test_kalman_waits_for_a_detection_and_clamps_the_speed():

@@ -15,14 +15,9 @@ from scipy.ndimage import distance_transform_edt
 from pegame.api import Context, EvaderObservation
 from pegame.types import Body, Camera, Pose
 from pegame.errors import ConfigError
-from pegame.evaders.smart import (
-    MAX_RECORDED_CANDIDATES,
-    SmartEvader,
-    _grow,
-    _sample_positions,
-    disc_half_widths,
-)
-from pegame.visibility import visibility_region
+from pegame.evaders.escape import MAX_RECORDED_CANDIDATES, _grow, _sample_positions, disc_half_widths
+from pegame.evaders.smart import SmartEvader
+from pegame.visibility import VisibilityRegion, visibility_region
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid, load_map
 from pegame.navigation import Planner
 from pegame.registry import make_config
@@ -72,18 +67,18 @@ def cell_of(xy) -> tuple[int, int]:
 
 def bfs_reachable(traversable: np.ndarray, start: tuple[int, int]) -> np.ndarray:
     """4-connected flood fill of ``traversable`` from ``start``."""
-    seen = np.zeros_like(traversable)
-    seen[start] = True
+    reached = np.zeros_like(traversable)
+    reached[start] = True
     queue = deque([start])
     while queue:
         r, c = queue.popleft()
         for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1)):
             nr, nc = r + dr, c + dc
-            if 0 <= nr < seen.shape[0] and 0 <= nc < seen.shape[1]:
-                if traversable[nr, nc] and not seen[nr, nc]:
-                    seen[nr, nc] = True
+            if 0 <= nr < reached.shape[0] and 0 <= nc < reached.shape[1]:
+                if traversable[nr, nc] and not reached[nr, nc]:
+                    reached[nr, nc] = True
                     queue.append((nr, nc))
-    return seen
+    return reached
 
 
 def dijkstra(traversable: np.ndarray, start: tuple[int, int]) -> np.ndarray:
@@ -116,7 +111,7 @@ def brute_costs(grid, evader_pose, pursuer_pose, distance, margin=0.0) -> np.nda
     """Algorithm 2's cost (H, W) for every candidate cell by plain loops; inf elsewhere.
     Candidates lie more than ``margin`` m (centre to centre) from every visible cell."""
     visible = visibility_region(grid, pursuer_pose, CAMERA)
-    seen = np.argwhere(visible)
+    in_region = np.argwhere(visible)
     e_trav = Planner(grid, EVADER.radius).traversable
     p_trav = Planner(grid, PURSUER.radius).traversable
     e_cell, p_cell = cell_of((evader_pose.x, evader_pose.y)), cell_of((pursuer_pose.x, pursuer_pose.y))
@@ -128,7 +123,7 @@ def brute_costs(grid, evader_pose, pursuer_pose, distance, margin=0.0) -> np.nda
         for c in range(grid.width):
             if grid.data[r, c] != FREE or not reach[r, c] or visible[r, c]:
                 continue
-            if margin > 0 and len(seen) and np.hypot(*(seen - (r, c)).T).min() * RES <= margin:
+            if margin > 0 and len(in_region) and np.hypot(*(in_region - (r, c)).T).min() * RES <= margin:
                 continue
             if distance == "euclidean":
                 x, y = centre(r, c)
@@ -194,7 +189,7 @@ def test_goal_is_the_brute_force_argmin(distance, seed, margin):
 
 def assert_same_escape(smart, me, pursuer):
     """The fast escape equals the numpy reference exactly; returns it."""
-    fast, slow = smart.escape(me, pursuer), smart.escape_reference(me, pursuer)
+    fast, slow = smart.search.escape(me, pursuer), smart.search.escape_reference(me, pursuer)
     assert (fast.cell, fast.cost, fast.count) == (slow.cell, slow.cost, slow.count)
     np.testing.assert_array_equal(fast.sample, slow.sample)
     return fast
@@ -212,6 +207,43 @@ def test_escape_kernels_match_the_numpy_reference(distance, margin, stride):
 
 
 @pytest.mark.parametrize("distance", ["euclidean", "geodesic"])
+def test_the_games_region_gives_the_same_decisions(distance):
+    """The region the game passes (whole, computed in part, or not yet computed) gives the
+    decisions the evader makes computing its own."""
+    for seed in range(12):
+        grid, pursuer, me = random_scene(seed, 40, 8)
+        own, told = make_evader(grid, distance), make_evader(grid, distance)
+        for step, offset in enumerate((0.0, 0.3, -0.2)):
+            p = Pose(pursuer.x, pursuer.y, pursuer.theta + offset)
+            region = VisibilityRegion(grid, p, CAMERA)
+            if step == 1:
+                region.holds(np.arange(0, grid.height * grid.width, 7))  # as the estimator asks
+            if step == 2:
+                region.mask  # already computed whole, as a recorder does
+            mine = own.decide(EvaderObservation(float(step), me, p))
+            given = told.decide(EvaderObservation(float(step), me, p, region))
+            assert given.goal == mine.goal and np.array_equal(given.path, mine.path)
+            np.testing.assert_array_equal(given.info["candidates"], mine.info["candidates"])
+            assert given.info["escape_cost"] == mine.info["escape_cost"]
+            fast = told.search.escape(me, p, region)
+            slow = told.search.escape_reference(me, p)
+            assert (fast.cell, fast.cost, fast.count) == (slow.cell, slow.cost, slow.count)
+
+
+def test_the_evader_escapes_the_region_it_is_given():
+    """With a region given, the evader does not build its own: a region of another camera
+    gives the decision of an evader built with that camera."""
+    grid, pursuer, me = random_scene(3, 40, 8)
+    wide = Camera(fov=2.5, near=0.1, far=3.0, angle_step=0.004, distance_step=0.05)
+    wide_region = VisibilityRegion(grid, pursuer, wide)
+    told = make_evader(grid).decide(EvaderObservation(0.0, me, pursuer, wide_region))
+    built = make_evader(grid, camera=wide).decide(EvaderObservation(0.0, me, pursuer))
+    own = make_evader(grid).decide(EvaderObservation(0.0, me, pursuer))
+    assert told.goal == built.goal and told.info["escape_cost"] == built.info["escape_cost"]
+    assert told.info["escape_cost"] != own.info["escape_cost"]
+
+
+@pytest.mark.parametrize("distance", ["euclidean", "geodesic"])
 def test_escape_kernels_match_the_reference_on_a_paper_map(distance):
     grid = load_map(MAPS_DIR / "enclosed.yaml")
     camera, evader, pursuer_body = Camera(), Body(0.25, 0.5, 1.8), Body(0.2, 0.5, 1.8)
@@ -222,10 +254,10 @@ def test_escape_kernels_match_the_reference_on_a_paper_map(distance):
     for k in range(10 if distance == "euclidean" else 3):
         i, j = rng.integers(rows.size, size=2)
         pursuer = Pose(*grid.cell_to_world(rows[i], cols[i]), rng.uniform(-math.pi, math.pi))
-        seen_rows, seen_cols = np.nonzero(visibility_region(grid, pursuer, camera) & smart.planner.traversable)
-        if k % 2 and seen_rows.size:  # the evader in view: the search has to go far
-            i = rng.integers(seen_rows.size)
-            me = Pose(*grid.cell_to_world(seen_rows[i], seen_cols[i]), 0.0)
+        in_rows, in_cols = np.nonzero(visibility_region(grid, pursuer, camera) & smart.planner.traversable)
+        if k % 2 and in_rows.size:  # the evader in the region: the search has to go far
+            i = rng.integers(in_rows.size)
+            me = Pose(*grid.cell_to_world(in_rows[i], in_cols[i]), 0.0)
         else:
             me = Pose(*grid.cell_to_world(rows[j], cols[j]), 0.0)
         recorded.append(assert_same_escape(smart, me, pursuer).sample.size)
@@ -376,9 +408,9 @@ def test_same_goal_keeps_the_path_and_info_is_bounded():
 def test_candidate_stride_scores_every_kth_cell():
     grid, pursuer, me = random_scene(1)
     smart = make_evader(grid, candidate_stride=3)
-    rows, cols = np.divmod(smart.candidates(me, pursuer), grid.width)
+    rows, cols = np.divmod(smart.search.candidates(me, pursuer), grid.width)
     assert rows.size > 0 and np.all(rows % 3 == 0) and np.all(cols % 3 == 0)
-    assert rows.size < make_evader(grid).candidates(me, pursuer).size / 4
+    assert rows.size < make_evader(grid).search.candidates(me, pursuer).size / 4
     goal = cell_of(smart.decide(EvaderObservation(0.0, me, pursuer)).goal)
     assert goal[0] % 3 == 0 and goal[1] % 3 == 0
 

@@ -11,10 +11,11 @@ every control tick, the pursuer's detection (or None) and visibility region V_k^
   draws a speed V ~ U[0, v_max] (m/s) and a turn rate omega ~ N(0, turn_rate_std^2) (rad/s)
   and moves for dt seconds along the heading at the middle of the step.
 - Measurement model: with a detection at z (map frame, m), w_i *= exp(-|p_i - z|^2 /
-  (2 sigma^2)) and particles inside V_k^p are multiplied by seen_boost; without one,
-  particles inside V_k^p are multiplied by miss_factor (negative information: the evader
-  would have been seen there). Particles in blocked cells (occupied or unknown) or off the
-  grid get weight 0. Weights are then normalised to sum to 1.
+  (2 sigma^2)) and the particles in_region (their cell inside V_k^p) are multiplied by
+  in_region_boost; without one, the particles in_region are multiplied by miss_factor
+  (negative information: the evader would have been detected there). Particles in blocked
+  cells (occupied or unknown) or off the grid get weight 0. Weights are then normalised to
+  sum to 1.
 - Degeneracy, the paper's Eq. for the effective sample size: N_eff = 1 / sum_i w_i^2. When
   N_eff < rho * N (0 <= rho <= 1, the paper uses rho = 0.8) the particles are resampled and
   the weights reset to 1/N.
@@ -29,16 +30,15 @@ every control tick, the pursuer's detection (or None) and visibility region V_k^
 The estimate is the weighted mean of the particle positions (the paper), with their
 weighted covariance (m^2).
 
-The resampling schemes are filterpy.monte_carlo's systematic, stratified, residual and
-multinomial resampling, written here on the plugin's own Generator: filterpy's draw from
-numpy's global RNG (not reproducible per component), loop in Python (about 1 ms for 2000
-particles) and its residual_resample computes the residual from w instead of N w (filterpy
-issue #290). The tests compare these against filterpy's.
+Resampling (``Config.resampler``) is one of the schemes of
+:mod:`pegame.estimators.resampling` (systematic, stratified, residual or multinomial, as
+filterpy.monte_carlo draws them, on the plugin's own Generator), behind its
+:class:`~pegame.estimators.resampling.ThresholdResampler` with the threshold rho.
 
 Fast path. :meth:`ParticleFilter.update` runs the per-particle work in numba kernels:
 one moves the particles and finds their cells, one weighs them, normalises the weights
-and computes N_eff, one inverts the cumulative weights for resampling (systematic
-positions by counting), one computes the mean and covariance. It asks V_k^p only about
+and computes N_eff, one computes the mean and covariance; the resampler's kernels invert
+the cumulative weights. It asks V_k^p only about
 the cells its moved particles landed in (``VisibilityRegion.holds``), so the camera's
 rays are cast only towards those in its field of view, with the same answer as the whole
 mask. The motion draws come from the component's Generator, a batch of updates at a
@@ -65,10 +65,10 @@ from pegame.types import Belief, Detection, Pose
 from pegame.errors import MapError, require
 from pegame.visibility import VisibilityRegion
 from pegame.trig import MAX_ANGLE, sin_cos
+from pegame.estimators.resampling import RESAMPLERS, ThresholdResampler, effective_sample_size
 
 log = logging.getLogger(__name__)
 
-RESAMPLERS = ("systematic", "stratified", "residual", "multinomial")
 #: a detection this many sigmas from all the particles' weight means the track is lost
 LOST_GATE = 5.0
 #: redraws of initial particles that land in blocked cells before snapping them to free ones
@@ -80,147 +80,6 @@ NOISE_BATCH = 32
 def wrap(angles: np.ndarray) -> np.ndarray:
     """Wrap angles (rad) to (-pi, pi]."""
     return np.pi - np.mod(np.pi - angles, 2.0 * np.pi)
-
-
-def effective_sample_size(weights: np.ndarray) -> float:
-    """N_eff = 1 / sum(w^2) of normalised weights (N,) (the paper's Eq.)."""
-    return 1.0 / float(np.dot(weights, weights))
-
-
-def resample(
-    weights: np.ndarray, scheme: str, rng: np.random.Generator, reference: bool = False
-) -> np.ndarray:
-    """Indices (N,) of the particles drawn with ``scheme`` (one of RESAMPLERS) from the
-    non-negative ``weights`` (N,), which need not sum to 1 but must have a positive sum.
-
-    Same draws as filterpy.monte_carlo's functions fed the same uniform numbers (residual:
-    with the residual N w - floor(N w), the published algorithm). Only particles of
-    positive weight are ever drawn. ``reference`` inverts the cumulative weights with
-    plain numpy instead of the kernel (same indices).
-    """
-    invert = _invert_reference if reference else _invert
-    n = weights.size
-    w = weights / weights.sum()
-    if scheme == "residual":
-        copies = np.floor(n * w).astype(np.int64)
-        kept = np.repeat(np.arange(n), copies)
-        rest = n - kept.size
-        if rest == 0:
-            return kept
-        return np.concatenate([kept, invert(n * w - copies, rng.random(rest))])
-    if scheme == "systematic":
-        if not reference:
-            return _systematic(w, rng.random())
-        positions = (rng.random() + np.arange(n)) / n
-    elif scheme == "stratified":
-        positions = (rng.random(n) + np.arange(n)) / n
-    elif scheme == "multinomial":
-        positions = rng.random(n)
-    else:
-        raise ValueError(f"Unknown resampler {scheme!r}; use one of {', '.join(RESAMPLERS)}.")
-    return invert(w, positions)
-
-
-@njit(cache=True)
-def _cumulative(weights):
-    """(cumulative (N,), last): the cumulative sums of the non-negative ``weights`` (N,),
-    accumulated in order and normalised by their total, and the index of the last positive
-    weight."""
-    cumulative = np.empty(weights.size)
-    running = 0.0
-    for i in range(weights.size):
-        running += weights[i]
-        cumulative[i] = running
-    cumulative /= cumulative[-1]
-    last = weights.size - 1
-    while weights[last] == 0.0:
-        last -= 1
-    return cumulative, last
-
-
-@njit(cache=True)
-def _invert(weights, positions):
-    """For each position in [0, 1), the index whose cumulative-weight interval holds it.
-
-    Numba version of :func:`_invert_reference`, same indices: the cumulative sum is
-    accumulated in the same order, and each search returns the first index whose
-    normalised cumulative weight exceeds the position, as searchsorted(side="right") does.
-    """
-    cumulative, last = _cumulative(weights)
-    indices = np.empty(positions.size, dtype=np.int64)
-    found = 0
-    for k in range(positions.size):
-        # Systematic and stratified positions increase, so each search starts where the
-        # previous one ended and the whole pass is linear; multinomial ones restart at 0.
-        if k > 0 and positions[k] < positions[k - 1]:
-            found = 0
-        found = _upper_bound(cumulative, positions[k], found)
-        # Round-off can leave the cumulative sum just below 1, or make the last systematic
-        # position exactly 1, and the search then returns N: such positions belong to the
-        # last particle of positive weight (never to a trailing zero-weight one).
-        indices[k] = min(found, last)
-    return indices
-
-
-@njit(cache=True)
-def _systematic(weights, offset):
-    """:func:`_invert` of the systematic positions (offset + k) / N, k = 0..N-1, for the
-    N ``weights`` and ``offset`` in [0, 1): the same indices, without a search.
-
-    Particle i takes the positions below its normalised cumulative weight C_i and not
-    below C_(i-1); there are c_i = ceil(N C_i - offset) positions below C_i (checked
-    against the positions themselves, computed as numpy computes them, so round-off
-    cannot shift one). Position k's index is then the number of particles with c_i <= k,
-    a running count over k: no branch depends on the weights, about twice as fast as the
-    search on a real filter's weights.
-    """
-    n = weights.size
-    cumulative, last = _cumulative(weights)
-    ending = np.zeros(n + 1, dtype=np.int64)  # ending[c]: particles with c_i == c
-    for i in range(n):
-        below = min(max(math.ceil(cumulative[i] * n - offset), 0), n)
-        while below > 0 and (offset + (below - 1)) / n >= cumulative[i]:
-            below -= 1
-        while below < n and (offset + below) / n < cumulative[i]:
-            below += 1
-        ending[below] += 1
-    indices = np.empty(n, dtype=np.int64)
-    passed = 0
-    for k in range(n):
-        passed += ending[k]
-        # As in _invert, a position that round-off puts past the last positive weight
-        # belongs to that particle.
-        indices[k] = min(passed, last)
-    return indices
-
-
-@njit(cache=True)
-def _upper_bound(values, value, start):
-    """First index i >= start of the non-decreasing ``values`` with values[i] > value
-    (values.size when none), given values[start - 1] <= value: a galloping search, so
-    cheap when the answer is near ``start``."""
-    low, step = start, 1
-    high = start
-    while high < values.size and values[high] <= value:
-        low = high + 1
-        high = low + step
-        step *= 2
-    high = min(high, values.size)
-    while low < high:
-        middle = (low + high) // 2
-        if values[middle] <= value:
-            low = middle + 1
-        else:
-            high = middle
-    return low
-
-
-def _invert_reference(weights: np.ndarray, positions: np.ndarray) -> np.ndarray:
-    """Plain numpy :func:`_invert`."""
-    cumulative = np.cumsum(weights)
-    cumulative /= cumulative[-1]
-    indices = np.searchsorted(cumulative, positions, side="right")
-    return np.minimum(indices, np.flatnonzero(weights)[-1])
 
 
 # --------------------------------------------------------------------------- kernels
@@ -325,7 +184,7 @@ def _exponents(moved, zx, zy, two_sigma2):
 
 
 @njit(cache=True)
-def _weigh(prior, cells, seen, likelihood, detected, seen_boost, miss_factor):
+def _weigh(prior, cells, in_region, likelihood, detected, in_region_boost, miss_factor):
     """Measurement update of the weights (module docstring): (weights (N,), total,
     evidence, n_eff).
 
@@ -333,17 +192,17 @@ def _weigh(prior, cells, seen, likelihood, detected, seen_boost, miss_factor):
     ``detected``, else ones. The weights are normalised to sum to 1 when their
     pre-normalisation ``total`` is positive and finite (n_eff = 1 / sum w^2 then, else 0).
     ``evidence`` = sum_i prior_i L_i over the particles on free cells (0 without a
-    detection). cells: flat cell index per particle (-1 blocked); seen: per particle,
+    detection). cells: flat cell index per particle (-1 blocked); in_region: per particle,
     whether V holds its cell.
     """
     n = prior.size
-    inside = seen_boost if detected else miss_factor
+    inside = in_region_boost if detected else miss_factor
     weights = np.empty(n)
     total = evidence = 0.0
     for i in range(n):  # selects, not branches: vectorised
         free = cells[i] >= 0
         evidence += prior[i] * likelihood[i] if free else 0.0
-        weights[i] = prior[i] * (likelihood[i] * (inside if seen[i] else 1.0)) if free else 0.0
+        weights[i] = prior[i] * (likelihood[i] * (inside if in_region[i] else 1.0)) if free else 0.0
         total += weights[i]
     if not detected:
         evidence = 0.0
@@ -388,7 +247,7 @@ class ParticleFilter(Estimator):
         resampler: str = "systematic"  # systematic, stratified, residual or multinomial
         sigma: float = 0.3  # m, std of the Gaussian likelihood of a detected position
         turn_rate_std: float = 1.0  # rad/s, std of the motion model's random turn rate
-        seen_boost: float = 2.0  # weight factor (>= 1) inside the visible region on a detection
+        in_region_boost: float = 2.0  # weight factor (>= 1) inside the visible region on a detection
         miss_factor: float = 0.05  # weight factor in [0, 1] inside the visible region on a miss
         init_spread: float = 0.3  # m, std of the initial cloud around the first detection
 
@@ -401,10 +260,11 @@ class ParticleFilter(Estimator):
             require(self.sigma > 0.0, key("sigma"), "a std > 0 m", self.sigma)
             turn = self.turn_rate_std
             require(turn >= 0.0, key("turn_rate_std"), "a std >= 0 rad/s", turn)
-            require(self.seen_boost >= 1.0, key("seen_boost"), "a factor >= 1", self.seen_boost)
+            boost = self.in_region_boost
+            require(boost >= 1.0, key("in_region_boost"), "a factor >= 1", boost)
             require(0.0 <= self.miss_factor <= 1.0, key("miss_factor"), "[0, 1]", self.miss_factor)
             require(self.init_spread >= 0.0, key("init_spread"), "a std >= 0 m", self.init_spread)
-            for name in ("sigma", "turn_rate_std", "seen_boost", "init_spread"):
+            for name in ("sigma", "turn_rate_std", "in_region_boost", "init_spread"):
                 value = getattr(self, name)
                 require(math.isfinite(value), key(name), "a finite number", value)
 
@@ -422,6 +282,7 @@ class ParticleFilter(Estimator):
         self._normals = np.empty(NOISE_BATCH * n)
         self._noise_used = self._unit_speeds.size  # none drawn yet
         self._ones = np.ones(n)  # the likelihood of no detection
+        self._resampler = ThresholdResampler(RESAMPLERS[config.resampler](), config.rho)
 
     # ------------------------------------------------------------------ interface
 
@@ -471,10 +332,12 @@ class ParticleFilter(Estimator):
         lost = detection is not None and evidence < math.exp(-0.5 * LOST_GATE**2)
         if lost or not (total > 0.0 and math.isfinite(total)):
             return self._reinitialise(detection, visible)
-        resampled = n_eff < cfg.rho * cfg.n_particles
+        resample = self._resampler.resample_reference if reference else self._resampler.resample
+        drawn = resample(weights, self.rng, n_eff)
+        resampled = drawn is not None
         if resampled:
             # take() copies rows three times faster than fancy indexing.
-            moved = np.take(moved, resample(weights, cfg.resampler, self.rng, reference), axis=0)
+            moved = np.take(moved, drawn, axis=0)
             weights = np.full(cfg.n_particles, 1.0 / cfg.n_particles)
         self.particles, self.weights = moved, weights
         return self._belief(n_eff, resampled, reference)
@@ -491,14 +354,14 @@ class ParticleFilter(Estimator):
             self.particles, *self._draw(), self.context.evader.v_max, cfg.turn_rate_std, dt,
             self.context.grid.frame, self.context.grid.blocked,
         )
-        seen = visible.holds(cells)  # V only where the particles are (module docstring)
+        in_region = visible.holds(cells)  # V only where the particles are (module docstring)
         if detection is None:
             likelihood = self._ones
         else:
             # numpy's exp is vectorised, 15 times faster than a loop of libm's.
             likelihood = np.exp(_exponents(moved, *detection.position, 2.0 * cfg.sigma**2))
         weights, total, evidence, n_eff = _weigh(
-            self.weights, cells, seen, likelihood, detection is not None, cfg.seen_boost,
+            self.weights, cells, in_region, likelihood, detection is not None, cfg.in_region_boost,
             cfg.miss_factor,
         )
         return moved, weights, total, evidence, n_eff
@@ -510,14 +373,14 @@ class ParticleFilter(Estimator):
         moved = self._predict(dt, self.context.evader.v_max * unit_speeds, cfg.turn_rate_std * normals)
         flat, on_grid = self._cells(moved[:, 0], moved[:, 1])
         valid = on_grid & ~self._blocked[flat]
-        seen = on_grid & self._flat_mask(visible.mask)[flat]
+        in_region = on_grid & self._flat_mask(visible.mask)[flat]
         if detection is None:
             evidence = 0.0
-            factor = np.where(seen, cfg.miss_factor, 1.0)
+            factor = np.where(in_region, cfg.miss_factor, 1.0)
         else:
             likelihood = self._likelihood(moved, detection.position) * valid
             evidence = float(np.dot(self.weights, likelihood))
-            factor = likelihood * np.where(seen, cfg.seen_boost, 1.0)
+            factor = likelihood * np.where(in_region, cfg.in_region_boost, 1.0)
         weights = self.weights * factor * valid
         total = float(weights.sum())
         if not (total > 0.0 and math.isfinite(total)):

@@ -2,8 +2,9 @@
 
 At every decision the evader is told the pursuer's pose (the paper's assumption) and:
 
-1. computes the pursuer's visibility region V (Algorithm 1, with occlusion:
-   :func:`pegame.visibility.visibility_region` for ``context.camera``);
+1. takes the pursuer's visibility region V (Algorithm 1, with occlusion:
+   :class:`pegame.visibility.VisibilityRegion` for ``context.camera``) as the game computed
+   it this tick (``EvaderObservation.pursuer_region``), or computes it when not given;
 2. takes as candidate goals the cells of F \\ V it can reach: traversable for its radius
    and connected to its own cell (:meth:`pegame.navigation.Planner.reachable`), minus V;
 3. scores each candidate i with Algorithm 2's
@@ -41,268 +42,33 @@ of lower row-major index then wins, so the evader moves into such a region.
 When no candidate exists (V covers all the free space the evader can reach) the evader
 logs it at INFO and keeps following its current plan (it stands still when it has none).
 
-Cost control: V and the argmin are recomputed at every decision, but the path is
-replanned only when the chosen goal moves by more than one cell (Chebyshev distance) from
-the goal being followed. ``candidate_stride`` k > 1 scores only the cells whose row and
+Cost control: the argmin is recomputed at every decision (V too, when not given), but
+the path is replanned only when the chosen goal moves by more than one cell (Chebyshev
+distance) from the goal being followed. ``candidate_stride`` k > 1 scores only the cells whose row and
 column are both multiples of k (about 1/k^2 of them).
 
 Units and frames: metres, seconds and radians in the map frame of :mod:`pegame.grid`
 (x right, y up, row 0 = lowest y). Candidates are cell centres.
 
-Fast path. :meth:`SmartEvader.escape` returns the same goal, cost and recorded
-candidates as the plain numpy :meth:`SmartEvader.escape_reference` (the tests hold it to
-that, bit for bit), in numba kernels that skip most of the work:
-
-- The hide margin grows V by a disc: every run of visible cells in a row marks, in each
-  row within the margin, the run widened by the disc's half-width at that row offset,
-  inside V's bounding box padded by the margin. The disc holds the offsets whose
-  distance, computed as the Euclidean distance transform computes it, is within the
-  margin, so the grown V is the transform's.
-- The candidate cells of the evader's connected component are built once per component
-  and grouped in square tiles. Tiles are scored in increasing order of a lower bound of
-  their cost (the nearest distance to the evader over the farthest distance to the
-  pursuer), and the search stops at the first tile whose bound exceeds the best cost
-  found by more than round-off could explain (a relative slack of 1e-9). Ties are broken
-  explicitly by cell index, as np.argmin's first minimum does in row-major order. With
-  geodesic distances there is no such bound and every tile is scored.
-- The recorded candidates are picked from the component's cells by counting past the
-  few cells V hides, without listing every candidate.
+The argmin is :class:`pegame.evaders.escape.EscapeSearch`'s: numba kernels that skip
+most of the candidates, held bit for bit to a plain numpy reference.
 """
 
 from __future__ import annotations
 
 import logging
 import math
-import weakref
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
-from numba import njit
-from scipy.ndimage import distance_transform_edt
 
 from pegame.api import Evader, EvaderObservation
 from pegame.types import STOP, Plan, Pose, Velocity
 from pegame.errors import require
-from pegame.visibility import VisibilityRegion, visibility_region
+from pegame.evaders.escape import DISTANCES, EscapeSearch
 from pegame.navigation import PathFollower, Planner
 
 log = logging.getLogger(__name__)
-
-DISTANCES = ("euclidean", "geodesic")
-
-#: most candidate points put into Plan.info["candidates"] for the recorder (an evenly
-#: strided subsample: enough to show the set, few enough not to hide the map)
-MAX_RECORDED_CANDIDATES = 500
-#: edge (cells) of the square tiles that the fast argmin search scores or skips as a whole
-TILE = 8
-#: a tile is skipped only when its cost bound exceeds the best cost by this relative
-#: amount: far more than the round-off of the bound and of the costs (~1e-15)
-BOUND_SLACK = 1e-9
-
-
-class Escape(NamedTuple):
-    """One decision's argmin. cell: flat row-major index (row * width + col) of the goal
-    cell, -1 when there is no candidate. cost: its cost_escape (+inf when none). count:
-    the number of candidates. sample: flat indices of every
-    ceil(count / MAX_RECORDED_CANDIDATES)-th candidate in row-major order."""
-
-    cell: int
-    cost: float
-    count: int
-    sample: np.ndarray
-
-
-def escape_costs(effort: np.ndarray, dist: np.ndarray) -> np.ndarray:
-    """Algorithm 2's cost effort / dist per candidate (both in m, same shape).
-
-    A candidate at dist 0 (under the pursuer) costs +inf; dist +inf (out of the pursuer's
-    reach) with a finite effort costs 0.
-    """
-    cost = np.full(effort.shape, np.inf)
-    np.divide(effort, dist, out=cost, where=dist > 0)
-    return cost
-
-
-def subsample(points: np.ndarray, limit: int) -> np.ndarray:
-    """At most ``limit`` rows of ``points`` (K, ...), evenly spaced in their order."""
-    return points[:: _sample_step(len(points), limit)]
-
-
-def _sample_step(count: int, limit: int) -> int:
-    return max(1, math.ceil(count / limit))
-
-
-def disc_half_widths(margin: float, resolution: float) -> np.ndarray:
-    """Half-widths (cells) of the disc of cells within ``margin`` (m) of a cell, per row
-    offset 0, 1, ..., R: the largest column offset whose distance, computed as
-    scipy's distance_transform_edt does (sqrt of the integer squared offset, in cells,
-    times ``resolution`` m), is at most ``margin``."""
-    reach = 0
-    while (reach + 1) * resolution <= margin:
-        reach += 1
-    widths = np.zeros(reach + 1, dtype=np.int64)
-    for row in range(reach + 1):
-        while math.sqrt(row * row + (widths[row] + 1) ** 2) * resolution <= margin:
-            widths[row] += 1
-    return widths
-
-
-# ------------------------------------------------------------------ numba kernels
-
-
-@njit(cache=True)
-def _grow(visible, r0, r1, c0, c1, half_widths):
-    """The cells within the disc of ``half_widths`` of a cell of ``visible`` (H, W), whose
-    True cells all lie in rows [r0, r1) and columns [c0, c1): a bool window and its top
-    row and left column."""
-    reach = half_widths.size - 1
-    height, width = visible.shape
-    top, left = max(r0 - reach, 0), max(c0 - reach, 0)
-    bottom, right = min(r1 + reach, height), min(c1 + reach, width)
-    grown = np.zeros((bottom - top, right - left), dtype=np.bool_)
-    for row in range(r0, r1):
-        col = c0
-        while col < c1:
-            if not visible[row, col]:
-                col += 1
-                continue
-            start = col
-            while col < c1 and visible[row, col]:
-                col += 1
-            # The run [start, col) widened by the disc's half-width, in every row it reaches.
-            for offset in range(-reach, reach + 1):
-                target = row + offset
-                if top <= target < bottom:
-                    half = half_widths[abs(offset)]
-                    lo, hi = max(start - half, left), min(col + half, right)
-                    grown[target - top, lo - left : hi - left] = True
-    return grown, top, left
-
-
-@njit(cache=True)
-def _exposed_positions(exposed, top, left, width, position):
-    """Increasing indices, in a component's row-major cell list, of its cells that are
-    True in the ``exposed`` window at (top, left); ``position`` maps a flat cell index to
-    its index in the list, -1 outside the list."""
-    found = np.empty(exposed.size, dtype=np.int64)
-    count = 0
-    for row in range(exposed.shape[0]):
-        base = (row + top) * width + left
-        for col in range(exposed.shape[1]):
-            if exposed[row, col] and position[base + col] >= 0:
-                found[count] = position[base + col]
-                count += 1
-    return found[:count]
-
-
-@njit(cache=True)
-def _tile_bounds(boxes, ex, ey, px, py):
-    """Lower bound (T,) of effort / dist over each tile's box (x min, x max, y min,
-    y max) (m) of cell centres: the box's nearest distance to the evader at (ex, ey) over
-    its farthest distance to the pursuer at (px, py)."""
-    bounds = np.empty(boxes.shape[0])
-    for t in range(boxes.shape[0]):
-        x0, x1, y0, y1 = boxes[t, 0], boxes[t, 1], boxes[t, 2], boxes[t, 3]
-        nx, ny = max(x0 - ex, ex - x1, 0.0), max(y0 - ey, ey - y1, 0.0)
-        fx, fy = max(abs(x0 - px), abs(x1 - px)), max(abs(y0 - py), abs(y1 - py))
-        far = math.sqrt(fx * fx + fy * fy)
-        bounds[t] = math.sqrt(nx * nx + ny * ny) / far if far > 0.0 else np.inf
-    return bounds
-
-
-@njit(cache=True)
-def _best_candidate(tiles, bounds, starts, cells, rows, cols, xs, ys, exposed, top, left,
-                    agents, effort, dist):
-    """Algorithm 2's argmin over the unexposed cells: (flat cell, cost), (-1, inf) if none.
-
-    Cells come grouped by tile (tile t holds entries starts[t] to starts[t + 1]), with
-    their flat index, row, column and centre (m); ``tiles`` lists the tiles by
-    increasing bound. ``agents`` is (evader x, evader y, pursuer x, pursuer y) (m). With
-    flat distance fields ``effort`` and ``dist`` (m) the costs come from them, else from
-    Euclidean distances computed as :meth:`SmartEvader.costs` does.
-    """
-    ex, ey, px, py = agents
-    height, width = exposed.shape
-    best_cell, best_cost = -1, np.inf
-    for t in tiles:
-        if bounds[t] > best_cost * (1.0 + BOUND_SLACK):
-            break
-        for k in range(starts[t], starts[t + 1]):
-            row, col = rows[k] - top, cols[k] - left
-            if 0 <= row < height and 0 <= col < width and exposed[row, col]:
-                continue
-            if effort.size:
-                e, d = effort[cells[k]], dist[cells[k]]
-            else:
-                ax, ay, bx, by = xs[k] - ex, ys[k] - ey, xs[k] - px, ys[k] - py
-                e, d = math.sqrt(ax * ax + ay * ay), math.sqrt(bx * bx + by * by)
-            cost = e / d if d > 0.0 else np.inf
-            if cost < best_cost or (cost == best_cost and (best_cell < 0 or cells[k] < best_cell)):
-                best_cell, best_cost = cells[k], cost
-    return best_cell, best_cost
-
-
-@njit(cache=True)
-def _sample_positions(skipped, count, step):
-    """Indices in a list of the candidates numbered 0, step, 2 step, ... < count, where
-    the candidates are the list's entries except the increasing indices ``skipped``."""
-    picked = np.empty((count + step - 1) // step, dtype=np.int64)
-    passed = 0
-    for j in range(picked.size):
-        index = j * step + passed
-        while passed < skipped.size and skipped[passed] <= index:
-            passed += 1
-            index += 1
-        picked[j] = index
-    return picked
-
-
-# ------------------------------------------------------------------ candidate cells
-
-
-#: the components built so far, by planner (shared per map and radius) and candidate stride
-_COMPONENTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-@dataclass(frozen=True, eq=False)
-class _Component:
-    """The candidate cells (on the candidate stride) of one connected component.
-
-    mask: bool (H, W), the component. cells: flat indices (K,), row-major. position:
-    (H * W,) index of each flat cell in ``cells``, -1 elsewhere. by_tile: the cells
-    grouped by tile (row-major within a tile) as a dict of (K,) arrays "cells", "rows",
-    "cols", "xs", "ys" (centres, m). starts: (T + 1,) where each tile's cells begin in
-    by_tile. boxes: (T, 4) (x min, x max, y min, y max) (m) of each tile's centres.
-    """
-
-    mask: np.ndarray
-    cells: np.ndarray
-    position: np.ndarray
-    by_tile: dict
-    starts: np.ndarray
-    boxes: np.ndarray
-
-    @classmethod
-    def build(cls, mask: np.ndarray, strided: np.ndarray, centres: np.ndarray) -> _Component:
-        """The component ``mask`` (bool (H, W)) with its cells on the ``strided`` mask
-        (bool (H, W)); ``centres`` (H * W, 2) are the cell centres (m) by flat index."""
-        cells = np.flatnonzero(mask & strided)
-        position = np.full(mask.size, -1, dtype=np.int64)
-        position[cells] = np.arange(cells.size)
-        rows, cols = np.divmod(cells, mask.shape[1])
-        tiles = (rows // TILE) * (mask.shape[1] // TILE + 1) + cols // TILE
-        order = np.argsort(tiles, kind="stable")  # stable: row-major within a tile
-        grouped = cells[order]
-        xs, ys = centres[grouped, 0], centres[grouped, 1]
-        by_tile = {"cells": grouped, "rows": rows[order], "cols": cols[order], "xs": xs, "ys": ys}
-        starts = np.append(np.flatnonzero(np.diff(tiles[order], prepend=-1)), cells.size)
-        begin = starts[:-1]
-        boxes = np.column_stack([
-            np.minimum.reduceat(xs, begin), np.maximum.reduceat(xs, begin),
-            np.minimum.reduceat(ys, begin), np.maximum.reduceat(ys, begin),
-        ])
-        return cls(mask, cells, position, by_tile, starts, boxes)
 
 
 class SmartEvader(Evader):
@@ -330,17 +96,14 @@ class SmartEvader(Evader):
         grid = context.grid
         self.planner = Planner.shared(grid, context.evader.radius)
         # The pursuer's planner only serves its geodesic distance field.
-        self.pursuer_planner = (
+        pursuer_planner = (
             Planner.shared(grid, context.pursuer.radius) if config.distance == "geodesic" else None
         )
+        self.search = EscapeSearch(
+            grid, context.camera, self.planner, pursuer_planner, config.distance,
+            config.candidate_stride, config.hide_margin,
+        )
         self.follower = PathFollower(context.evader)
-        rows, cols = np.indices(grid.data.shape)
-        # Cell centres (m, map frame) by flat row-major cell index, shape (H * W, 2).
-        self._centres = np.column_stack([v.ravel() for v in grid.cell_to_world(rows, cols)])
-        stride = config.candidate_stride
-        self._strided = (rows % stride == 0) & (cols % stride == 0)
-        self._half_widths = disc_half_widths(config.hide_margin, grid.resolution)
-        self._component: _Component | None = None
         self.plan = Plan()
         self._goal_cell: tuple[int, int] | None = None
 
@@ -349,15 +112,15 @@ class SmartEvader(Evader):
         self.follower.set_path(np.zeros((0, 2)))
 
     def decide(self, observation: EvaderObservation) -> Plan:
-        """Recompute V and the escape goal; replan when the goal moved by more than a cell.
+        """Find the escape goal for this tick's V; replan when it moved by more than a cell.
 
         The returned plan's goal and path are those being followed; its info holds
         "candidates", float (K, 2) candidate cell centres (m, map frame, at most
-        MAX_RECORDED_CANDIDATES of them, evenly subsampled), and "escape_cost", the cost of
-        this decision's argmin (+inf when there is no candidate).
+        escape.MAX_RECORDED_CANDIDATES of them, evenly subsampled), and "escape_cost", the
+        cost of this decision's argmin (+inf when there is no candidate).
         """
         me, pursuer = observation.pose, observation.pursuer
-        found = self.escape(me, pursuer)
+        found = self.search.escape(me, pursuer, observation.pursuer_region)
         if found.count == 0:
             log.info(
                 "t=%.2f s: the pursuer's view covers all free space the evader can reach; "
@@ -369,120 +132,17 @@ class SmartEvader(Evader):
         cell = divmod(found.cell, self.context.grid.width)
         goal, path = self.plan.goal, self.plan.path
         if self._needs_replan(cell):
-            goal = tuple(float(v) for v in self._centres[found.cell])
+            goal = tuple(float(v) for v in self.search.centres[found.cell])
             path = self.planner.plan((me.x, me.y), goal).path
             self.follower.set_path(path)
             self._goal_cell = cell
         # take() gathers rows several times faster than fancy indexing.
-        info = {"candidates": np.take(self._centres, found.sample, axis=0), "escape_cost": found.cost}
+        info = {"candidates": np.take(self.search.centres, found.sample, axis=0), "escape_cost": found.cost}
         self.plan = Plan(goal, path, info)
         return self.plan
 
     def control(self, observation: EvaderObservation) -> Velocity:
         return self.follower.command(observation.pose) if self.plan.goal is not None else STOP
-
-    def escape(self, me: Pose, pursuer: Pose) -> Escape:
-        """Algorithm 2's argmin for the evader at ``me`` and the pursuer at ``pursuer``:
-        the same result as :meth:`escape_reference`, by the kernels (module docstring)."""
-        grid = self.context.grid
-        visible = VisibilityRegion(grid, pursuer, self.context.camera)
-        component = self._component_at(me)
-        exposed, top, left = self._exposed(visible)
-        skipped = _exposed_positions(exposed, top, left, grid.width, component.position)
-        count = component.cells.size - skipped.size
-        if count == 0:
-            return Escape(-1, math.inf, 0, np.zeros(0, dtype=np.int64))
-        bounds, effort, dist = self._bounds(component, me, pursuer)
-        tiled = component.by_tile
-        cell, cost = _best_candidate(
-            np.argsort(bounds), bounds, component.starts, tiled["cells"], tiled["rows"],
-            tiled["cols"], tiled["xs"], tiled["ys"], exposed, top, left,
-            (me.x, me.y, pursuer.x, pursuer.y), effort, dist,
-        )
-        step = _sample_step(count, MAX_RECORDED_CANDIDATES)
-        sample = component.cells[_sample_positions(skipped, count, step)]
-        return Escape(int(cell), float(cost), count, sample)
-
-    def escape_reference(self, me: Pose, pursuer: Pose) -> Escape:
-        """:meth:`escape` in plain numpy over every candidate: the tests' reference."""
-        cells = self.candidates(me, pursuer)
-        if cells.size == 0:
-            return Escape(-1, math.inf, 0, cells)
-        cost = self.costs(me, pursuer, cells)
-        best = int(np.argmin(cost))  # first minimum = lowest row-major index among ties
-        sample = subsample(cells, MAX_RECORDED_CANDIDATES)
-        return Escape(int(cells[best]), float(cost[best]), cells.size, sample)
-
-    def candidates(self, me: Pose, pursuer: Pose) -> np.ndarray:
-        """Flat row-major indices (row * width + col, increasing) of the candidate cells:
-        reachable by the evader at ``me``, outside the visibility region of the pursuer at
-        ``pursuer`` (grown by the hide margin), and on the candidate stride. Plain numpy,
-        part of :meth:`escape_reference`."""
-        grid = self.context.grid
-        visible = visibility_region(grid, pursuer, self.context.camera)
-        if self.config.hide_margin > 0 and visible.any():
-            # Hidden means the whole body is out of view, not only its centre's cell.
-            visible = distance_transform_edt(~visible) * grid.resolution <= self.config.hide_margin
-        mask = self.planner.reachable((me.x, me.y)) & ~visible & self._strided
-        return np.flatnonzero(mask)
-
-    def costs(self, me: Pose, pursuer: Pose, cells: np.ndarray) -> np.ndarray:
-        """Algorithm 2's cost_escape (dimensionless) of the flat-indexed candidate ``cells``."""
-        if self.config.distance == "euclidean":
-            x, y = self._centres[cells].T
-            effort = np.sqrt((x - me.x) ** 2 + (y - me.y) ** 2)
-            dist = np.sqrt((x - pursuer.x) ** 2 + (y - pursuer.y) ** 2)
-        else:
-            effort = self.planner.distance_field((me.x, me.y)).ravel()[cells]
-            dist = self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()[cells]
-        return escape_costs(effort, dist)
-
-    def _component_at(self, me: Pose) -> _Component:
-        """The candidate cells of the evader's connected component: the one last used when
-        the cell the planner starts from (the evader's, or the nearest traversable one)
-        lies in it, else one built for an earlier game on this map (components are
-        disjoint, and shared by every evader with the same planner and candidate stride),
-        else a new one."""
-        grid = self.context.grid
-        shared = _COMPONENTS.setdefault(self.planner, {}).setdefault(self.config.candidate_stride, [])
-        row, col = grid.world_to_cell(me.x, me.y)
-        on_grid = 0 <= row < grid.height and 0 <= col < grid.width
-        source = None
-        for component in [self._component, *shared]:
-            if component is None:
-                continue
-            # A cell of a component is traversable, so it is the start cell itself.
-            if on_grid and component.mask[row, col]:
-                self._component = component
-                return component
-            if source is None:
-                source = self.planner.nearest_traversable((me.x, me.y))
-            if source is not None and component.mask[grid.world_to_cell(*source)]:
-                self._component = component
-                return component
-        reachable = self.planner.reachable((me.x, me.y))
-        self._component = _Component.build(reachable, self._strided, self._centres)
-        shared.append(self._component)
-        return self._component
-
-    def _exposed(self, visible: VisibilityRegion) -> tuple[np.ndarray, int, int]:
-        """V grown by the hide margin (no candidate lies there) over a window: a bool
-        mask, its top row and its left column."""
-        r0, r1, c0, c1 = visible.bounds
-        if r1 <= r0:
-            return np.zeros((0, 0), dtype=bool), 0, 0
-        return _grow(visible.mask, r0, r1, c0, c1, self._half_widths)
-
-    def _bounds(self, component: _Component, me: Pose, pursuer: Pose):
-        """Per-tile cost lower bounds (T,) and, for geodesic distances, the flat effort and
-        dist fields (m) (empty arrays for Euclidean ones)."""
-        if self.config.distance == "euclidean":
-            bounds = _tile_bounds(component.boxes, me.x, me.y, pursuer.x, pursuer.y)
-            return bounds, np.zeros(0), np.zeros(0)
-        # Path lengths have no useful bound: a cell out of the pursuer's reach costs 0.
-        effort = self.planner.distance_field((me.x, me.y)).ravel()
-        dist = self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()
-        return np.zeros(component.boxes.shape[0]), effort, dist
 
     def _needs_replan(self, cell: tuple[int, int]) -> bool:
         """True when there is no path to follow or ``cell`` is more than one cell (Chebyshev)
