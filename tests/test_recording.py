@@ -32,10 +32,10 @@ from pegame.types import (
 )
 from pegame.figures import plot_trajectory
 from pegame.game import Game
-from pegame.visibility import VisibilityRegion, fov_wedge, visibility_region
+from pegame.visibility import VisibilityRegion, fov_wedge
 from pegame.grid import OccupancyGrid
-from pegame.recorders import RerunRecorder, recording_id, visibility_outlines
-from pegame.replay import find_recordings, main as replay_main, viewer_command
+from pegame.recorders.rerun import RerunRecorder, recording_id
+from pegame.replay import find_recordings
 
 SHORT = ["game.t_max=5", "env=hall"]
 TICKS = 50  # 5 s at the default 10 Hz
@@ -78,9 +78,9 @@ def played(tmp_path_factory):
     return game, game.play(out_dir), out_dir
 
 
-def test_one_recording_per_game_named_after_it(played):
+def test_one_recording_per_game_named_after_it_and_complete(played):
     _, _, out_dir = played
-    assert sorted(p.name for p in out_dir.glob("*.rrd")) == ["game.rrd"]
+    assert [p.name for p in find_recordings(out_dir)] == ["game.rrd"]  # no partial file left
 
 
 def test_rerun_verifies_the_recording(played):
@@ -303,34 +303,6 @@ def test_recording_id_is_deterministic_per_place_and_config(tmp_path):
     assert recording_id(tmp_path, "game", config) != recording_id(tmp_path, "game", {"game": {"seed": 4}})
 
 
-@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-0.7, 1.3, 0.4)])
-def test_visibility_outlines_match_their_reference_and_bound_the_region(origin):
-    # Sparse walls on a large grid, so that the kernel's jumps over free cells are long.
-    rng = np.random.default_rng(8)
-    data = np.zeros((150, 150), dtype=np.int8)
-    data[rng.random(data.shape) < 0.003] = 100
-    data[40:110, 75] = 100
-    grid = OccupancyGrid(data, 0.05, origin)
-    camera = Camera()
-    free = np.argwhere(~grid.blocked)[rng.choice(int((~grid.blocked).sum()), 60)]
-    xs, ys = grid.cell_to_world(free[:, 0], free[:, 1])
-    thetas = rng.uniform(-math.pi, math.pi, 60)
-    fast = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01)
-    slow = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01, compiled=False)
-    np.testing.assert_array_equal(fast, slow)
-    assert fast.shape == (60, 64 + 8 + 1, 3) and np.array_equal(fast[:, 0], fast[:, -1])
-    in_region = []
-    for outline, x, y, theta in zip(fast, xs, ys, thetas):
-        mask = visibility_region(grid, Pose(x, y, theta), camera)
-        reach = np.hypot(outline[:64, 0] - x, outline[:64, 1] - y)
-        assert np.all(reach >= camera.near - 1e-4) and np.all(reach <= camera.far + 1e-4)
-        rows, cols = grid.world_to_cell(outline[:64, 0], outline[:64, 1])
-        beyond_near = reach > camera.near + 1e-4
-        in_region.extend(mask[rows[beyond_near], cols[beyond_near]])
-    # the far ends lie in visible cells (float32 rounding may move one across a cell edge)
-    assert len(in_region) > 2000 and np.mean(in_region) > 0.95
-
-
 def test_config_file_lists_every_field_with_its_default():
     conf = Path(__file__).resolve().parents[1] / "conf" / "recorder" / "rerun.yaml"
     values = yaml.safe_load(conf.read_text())
@@ -338,31 +310,10 @@ def test_config_file_lists_every_field_with_its_default():
     assert values == {"name": "rerun", **defaults}
 
 
-def test_importing_the_recorders_does_not_import_rerun():
-    code = "import sys, pegame.recorders; print('rerun' in sys.modules)"
+def test_importing_the_null_recorder_and_replay_does_not_import_rerun():
+    code = ("import sys, pegame.recorders, pegame.recorders.none, pegame.recorders.files, pegame.replay; "
+            "print('rerun' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
-
-
-# ------------------------------------------------------------------------ replay
-
-
-def test_replay_finds_recordings_recursively_sorted(tmp_path, capsys):
-    for name in ("job1/game_2.rrd", "job0/game_1.rrd", "job0/game_0.rrd"):
-        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
-        (tmp_path / name).write_bytes(b"x" * 1500)
-    files = find_recordings(tmp_path)
-    assert [p.relative_to(tmp_path).as_posix() for p in files] == ["job0/game_0.rrd", "job0/game_1.rrd", "job1/game_2.rrd"]
-    assert viewer_command(files)[:3] == [sys.executable, "-m", "rerun"]
-    assert replay_main([str(tmp_path), "--list"]) == 0
-    lines = capsys.readouterr().out.splitlines()
-    assert lines == [f"{p}  1.5 kB" for p in files]
-
-
-def test_replay_without_recordings_is_a_clear_error(tmp_path, capsys):
-    assert replay_main([str(tmp_path)]) == 2
-    assert "No Rerun recordings (*.rrd)" in capsys.readouterr().err
-    assert replay_main([str(tmp_path / "missing")]) == 2
-    assert "is not a directory" in capsys.readouterr().err
 
 
 # ----------------------------------------------------------------------- figures
