@@ -85,8 +85,7 @@ def test_one_recording_per_game_named_after_it_and_complete(played):
 
 def test_rerun_verifies_the_recording(played):
     _, _, out_dir = played
-    proc = subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(out_dir / "game.rrd")],
-                          capture_output=True, text=True, timeout=60)
+    proc = rrd_verify(out_dir / "game.rrd")
     assert proc.returncode == 0, proc.stderr
 
 
@@ -187,6 +186,89 @@ def test_unwritable_output_dir_warns_and_the_game_goes_on(played, compose_config
     with pytest.warns(RuntimeWarning, match="Rerun recording .* disabled"):
         result = Game(compose_config(["recorder=rerun", *SHORT])).play(blocker / "run").result
     assert result == outcome.result
+
+
+def rrd_verify(path: Path) -> subprocess.CompletedProcess:
+    """``rerun rrd verify path``, with the rerun CLI of this Python's rerun-sdk."""
+    return subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(path)],
+                          capture_output=True, text=True, timeout=60)
+
+
+def failing_at_decision(game: Game, count: int, error: BaseException) -> None:
+    """Make the game's pursuer raise ``error`` at its ``count``-th decision."""
+    decide, calls = game.plugins["pursuer"].decide, []
+
+    def failing(observation):
+        calls.append(observation.time)
+        if len(calls) == count:
+            raise error
+        return decide(observation)
+
+    game.plugins["pursuer"].decide = failing
+
+
+@pytest.fixture(scope="module")
+def failed(tmp_path_factory):
+    """The recording dir of a 5 s game whose pursuer raises at its third decision, at
+    step 20 (decisions at 1 Hz of 10 Hz control), before that tick is logged."""
+    from pegame.config import compose
+
+    out_dir = tmp_path_factory.mktemp("failed")
+    game = Game(compose(["recorder=rerun", *SHORT]))
+    failing_at_decision(game, 3, RuntimeError("pursuer broke"))
+    with pytest.raises(RuntimeError, match="pursuer broke"):
+        game.play(out_dir)
+    return out_dir
+
+
+def test_a_failed_game_leaves_a_failed_recording_readable_up_to_its_failure(failed):
+    from rerun.chunk import RrdReader
+
+    assert [p.name for p in find_recordings(failed)] == ["game.failed.rrd"]
+    path = failed / "game.failed.rrd"
+    proc = rrd_verify(path)
+    assert proc.returncode == 0, proc.stderr
+    steps, static, _ = read_steps(path)
+    for entity in PER_TICK:
+        assert steps[entity] == list(range(20)), entity  # flushed at the failure
+    assert "/__properties/failure" in static and "/__properties/result" not in static
+    events, failure = [], {}
+    for chunk in RrdReader(path).stream().to_chunks():
+        batch = chunk.to_record_batch()
+        if chunk.entity_path == "/events":
+            events += zip(batch.column("TextLog:level").to_pylist(), batch.column("TextLog:text").to_pylist())
+        elif chunk.entity_path == "/__properties/failure":
+            failure.update({name: batch.column(name).to_pylist()[0][0]
+                            for name in batch.schema.names if name != "rerun.controls.RowId"})
+    assert (["ERROR"], ["game failed after step 19: RuntimeError: pursuer broke"]) in events
+    assert failure == {"error": "RuntimeError", "message": "pursuer broke", "step": 19}
+
+
+def test_a_finished_game_supersedes_its_failed_recording(tmp_path):
+    context = small_context()
+    for abort in (True, False):
+        recorder = RerunRecorder(RerunRecorder.Config(), context, None)
+        recorder.start(str(tmp_path), "game_3", {})
+        names = sorted(p.name for p in tmp_path.iterdir())
+        assert names == (["game_3.rrd.partial"] if abort else ["game_3.failed.rrd", "game_3.rrd.partial"])
+        for tick in synthetic_ticks(context, 6):
+            recorder.log(tick)
+        if abort:
+            recorder.abort(KeyboardInterrupt())
+            assert sorted(p.name for p in tmp_path.iterdir()) == ["game_3.failed.rrd"]
+        else:
+            recorder.finish({})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["game_3.rrd"]
+    assert rrd_verify(tmp_path / "game_3.rrd").returncode == 0
+
+
+def test_a_game_that_fails_before_its_first_tick_leaves_a_failed_recording(tmp_path):
+    recorder = RerunRecorder(RerunRecorder.Config(), small_context(), None)
+    recorder.start(str(tmp_path), "game", {"game": {"seed": 1}})
+    recorder.abort(ValueError("bad spawn"))
+    assert [p.name for p in tmp_path.iterdir()] == ["game.failed.rrd"]
+    steps, static, _ = read_steps(tmp_path / "game.failed.rrd")
+    assert steps["/events"] == [0] and "/world/map" in static
 
 
 # ------------------------------------------------------------ the recorder alone
