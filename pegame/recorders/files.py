@@ -15,7 +15,7 @@ name never claims more than the file holds:
 The renames are ``os.replace`` in the same directory, atomic on POSIX file systems, done
 after the file is closed: a complete name survives a killed process. The file is not
 fsynced first (as :func:`pegame.files.write_atomic` does for results): a recording of
-megabytes would cost a game's worth of time on a slow disk, and a power cut is not what
+megabytes would add to every recorded game's time on a slow disk, and a power cut is not what
 the names guard against. A later game of the same id replaces the file of its status; a
 finished game also removes its failed file. This module imports nothing heavy:
 :mod:`pegame.replay` lists recordings without rerun-sdk.
