@@ -32,10 +32,10 @@ from pegame.types import (
 )
 from pegame.figures import plot_trajectory
 from pegame.game import Game
-from pegame.visibility import VisibilityRegion, fov_wedge, visibility_region
+from pegame.visibility import VisibilityRegion, fov_wedge
 from pegame.grid import OccupancyGrid
-from pegame.recorders import RerunRecorder, recording_id, visibility_outlines
-from pegame.replay import find_recordings, main as replay_main, viewer_command
+from pegame.recorders.rerun import RerunRecorder, recording_id
+from pegame.replay import find_recordings
 
 SHORT = ["game.t_max=5", "env=hall"]
 TICKS = 50  # 5 s at the default 10 Hz
@@ -78,15 +78,14 @@ def played(tmp_path_factory):
     return game, game.play(out_dir), out_dir
 
 
-def test_one_recording_per_game_named_after_it(played):
+def test_one_recording_per_game_named_after_it_and_complete(played):
     _, _, out_dir = played
-    assert sorted(p.name for p in out_dir.glob("*.rrd")) == ["game.rrd"]
+    assert [p.name for p in find_recordings(out_dir)] == ["game.rrd"]  # no partial file left
 
 
 def test_rerun_verifies_the_recording(played):
     _, _, out_dir = played
-    proc = subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(out_dir / "game.rrd")],
-                          capture_output=True, text=True, timeout=60)
+    proc = rrd_verify(out_dir / "game.rrd")
     assert proc.returncode == 0, proc.stderr
 
 
@@ -187,6 +186,89 @@ def test_unwritable_output_dir_warns_and_the_game_goes_on(played, compose_config
     with pytest.warns(RuntimeWarning, match="Rerun recording .* disabled"):
         result = Game(compose_config(["recorder=rerun", *SHORT])).play(blocker / "run").result
     assert result == outcome.result
+
+
+def rrd_verify(path: Path) -> subprocess.CompletedProcess:
+    """``rerun rrd verify path``, with the rerun CLI of this Python's rerun-sdk."""
+    return subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(path)],
+                          capture_output=True, text=True, timeout=60)
+
+
+def failing_at_decision(game: Game, count: int, error: BaseException) -> None:
+    """Make the game's pursuer raise ``error`` at its ``count``-th decision."""
+    decide, calls = game.plugins["pursuer"].decide, []
+
+    def failing(observation):
+        calls.append(observation.time)
+        if len(calls) == count:
+            raise error
+        return decide(observation)
+
+    game.plugins["pursuer"].decide = failing
+
+
+@pytest.fixture(scope="module")
+def failed(tmp_path_factory):
+    """The recording dir of a 5 s game whose pursuer raises at its third decision, at
+    step 20 (decisions at 1 Hz of 10 Hz control), before that tick is logged."""
+    from pegame.config import compose
+
+    out_dir = tmp_path_factory.mktemp("failed")
+    game = Game(compose(["recorder=rerun", *SHORT]))
+    failing_at_decision(game, 3, RuntimeError("pursuer broke"))
+    with pytest.raises(RuntimeError, match="pursuer broke"):
+        game.play(out_dir)
+    return out_dir
+
+
+def test_a_failed_game_leaves_a_failed_recording_readable_up_to_its_failure(failed):
+    from rerun.chunk import RrdReader
+
+    assert [p.name for p in find_recordings(failed)] == ["game.failed.rrd"]
+    path = failed / "game.failed.rrd"
+    proc = rrd_verify(path)
+    assert proc.returncode == 0, proc.stderr
+    steps, static, _ = read_steps(path)
+    for entity in PER_TICK:
+        assert steps[entity] == list(range(20)), entity  # flushed at the failure
+    assert "/__properties/failure" in static and "/__properties/result" not in static
+    events, failure = [], {}
+    for chunk in RrdReader(path).stream().to_chunks():
+        batch = chunk.to_record_batch()
+        if chunk.entity_path == "/events":
+            events += zip(batch.column("TextLog:level").to_pylist(), batch.column("TextLog:text").to_pylist())
+        elif chunk.entity_path == "/__properties/failure":
+            failure.update({name: batch.column(name).to_pylist()[0][0]
+                            for name in batch.schema.names if name != "rerun.controls.RowId"})
+    assert (["ERROR"], ["game failed after step 19: RuntimeError: pursuer broke"]) in events
+    assert failure == {"error": "RuntimeError", "message": "pursuer broke", "step": 19}
+
+
+def test_a_finished_game_supersedes_its_failed_recording(tmp_path):
+    context = small_context()
+    for abort in (True, False):
+        recorder = RerunRecorder(RerunRecorder.Config(), context, None)
+        recorder.start(str(tmp_path), "game_3", {})
+        names = sorted(p.name for p in tmp_path.iterdir())
+        assert names == (["game_3.rrd.partial"] if abort else ["game_3.failed.rrd", "game_3.rrd.partial"])
+        for tick in synthetic_ticks(context, 6):
+            recorder.log(tick)
+        if abort:
+            recorder.abort(KeyboardInterrupt())
+            assert sorted(p.name for p in tmp_path.iterdir()) == ["game_3.failed.rrd"]
+        else:
+            recorder.finish({})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["game_3.rrd"]
+    assert rrd_verify(tmp_path / "game_3.rrd").returncode == 0
+
+
+def test_a_game_that_fails_before_its_first_tick_leaves_a_failed_recording(tmp_path):
+    recorder = RerunRecorder(RerunRecorder.Config(), small_context(), None)
+    recorder.start(str(tmp_path), "game", {"game": {"seed": 1}})
+    recorder.abort(ValueError("bad spawn"))
+    assert [p.name for p in tmp_path.iterdir()] == ["game.failed.rrd"]
+    steps, static, _ = read_steps(tmp_path / "game.failed.rrd")
+    assert steps["/events"] == [0] and "/world/map" in static
 
 
 # ------------------------------------------------------------ the recorder alone
@@ -303,34 +385,6 @@ def test_recording_id_is_deterministic_per_place_and_config(tmp_path):
     assert recording_id(tmp_path, "game", config) != recording_id(tmp_path, "game", {"game": {"seed": 4}})
 
 
-@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-0.7, 1.3, 0.4)])
-def test_visibility_outlines_match_their_reference_and_bound_the_region(origin):
-    # Sparse walls on a large grid, so that the kernel's jumps over free cells are long.
-    rng = np.random.default_rng(8)
-    data = np.zeros((150, 150), dtype=np.int8)
-    data[rng.random(data.shape) < 0.003] = 100
-    data[40:110, 75] = 100
-    grid = OccupancyGrid(data, 0.05, origin)
-    camera = Camera()
-    free = np.argwhere(~grid.blocked)[rng.choice(int((~grid.blocked).sum()), 60)]
-    xs, ys = grid.cell_to_world(free[:, 0], free[:, 1])
-    thetas = rng.uniform(-math.pi, math.pi, 60)
-    fast = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01)
-    slow = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01, compiled=False)
-    np.testing.assert_array_equal(fast, slow)
-    assert fast.shape == (60, 64 + 8 + 1, 3) and np.array_equal(fast[:, 0], fast[:, -1])
-    in_region = []
-    for outline, x, y, theta in zip(fast, xs, ys, thetas):
-        mask = visibility_region(grid, Pose(x, y, theta), camera)
-        reach = np.hypot(outline[:64, 0] - x, outline[:64, 1] - y)
-        assert np.all(reach >= camera.near - 1e-4) and np.all(reach <= camera.far + 1e-4)
-        rows, cols = grid.world_to_cell(outline[:64, 0], outline[:64, 1])
-        beyond_near = reach > camera.near + 1e-4
-        in_region.extend(mask[rows[beyond_near], cols[beyond_near]])
-    # the far ends lie in visible cells (float32 rounding may move one across a cell edge)
-    assert len(in_region) > 2000 and np.mean(in_region) > 0.95
-
-
 def test_config_file_lists_every_field_with_its_default():
     conf = Path(__file__).resolve().parents[1] / "conf" / "recorder" / "rerun.yaml"
     values = yaml.safe_load(conf.read_text())
@@ -338,31 +392,10 @@ def test_config_file_lists_every_field_with_its_default():
     assert values == {"name": "rerun", **defaults}
 
 
-def test_importing_the_recorders_does_not_import_rerun():
-    code = "import sys, pegame.recorders; print('rerun' in sys.modules)"
+def test_importing_the_null_recorder_and_replay_does_not_import_rerun():
+    code = ("import sys, pegame.recorders, pegame.recorders.none, pegame.recorders.files, pegame.replay; "
+            "print('rerun' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
-
-
-# ------------------------------------------------------------------------ replay
-
-
-def test_replay_finds_recordings_recursively_sorted(tmp_path, capsys):
-    for name in ("job1/game_2.rrd", "job0/game_1.rrd", "job0/game_0.rrd"):
-        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
-        (tmp_path / name).write_bytes(b"x" * 1500)
-    files = find_recordings(tmp_path)
-    assert [p.relative_to(tmp_path).as_posix() for p in files] == ["job0/game_0.rrd", "job0/game_1.rrd", "job1/game_2.rrd"]
-    assert viewer_command(files)[:3] == [sys.executable, "-m", "rerun"]
-    assert replay_main([str(tmp_path), "--list"]) == 0
-    lines = capsys.readouterr().out.splitlines()
-    assert lines == [f"{p}  1.5 kB" for p in files]
-
-
-def test_replay_without_recordings_is_a_clear_error(tmp_path, capsys):
-    assert replay_main([str(tmp_path)]) == 2
-    assert "No Rerun recordings (*.rrd)" in capsys.readouterr().err
-    assert replay_main([str(tmp_path / "missing")]) == 2
-    assert "is not a directory" in capsys.readouterr().err
 
 
 # ----------------------------------------------------------------------- figures

@@ -1,0 +1,182 @@
+"""What a recording buffers between sends, and its encoding as Rerun columns.
+
+A control tick is faster than a few ``rr.log`` calls, so the recorder buffers ticks and
+sends each entity's rows at once with ``RecordingStream.send_columns``: a tick's numbers
+as one :data:`ROW` (see :func:`tick_row`), the particle subsamples in the preallocated
+:class:`ParticleRows`, and each other entity's variable-size rows in an
+:class:`EntityBuffer`. :func:`time_index` builds the ``step`` and ``sim_time`` index
+columns, :func:`strips_array` line strips as one Arrow array; points are float32 (n, 3)
+arrays in the map frame (m).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import rerun as rr
+
+from pegame.api import Tick
+
+STEP, SIM_TIME = "step", "sim_time"
+
+#: the numbers buffered per tick, in this order (NaN where there is nothing)
+ROW = (
+    "step", "time", "px", "py", "ptheta", "ex", "ey", "etheta",
+    "det_x", "det_y", "box_cx", "box_cy", "box_hw", "box_hh", "confidence", "depth",
+    "mean_x", "mean_y", "n_eff", "rate",
+)
+_NO_DETECTION = (math.nan,) * 8
+
+
+def tick_row(tick: Tick, rate: float) -> tuple:
+    """The tick's numbers in :data:`ROW` order; rate: the running tracking rate."""
+    p, e, det, belief = tick.pursuer, tick.evader, tick.detection, tick.belief
+    if det is None:
+        seen = _NO_DETECTION
+    else:
+        box = det.box
+        seen = (det.position[0], det.position[1], box.x + 0.5 * box.w, box.y + 0.5 * box.h,
+                0.5 * box.w, 0.5 * box.h, det.confidence, det.depth)
+    mean = belief.mean if belief.mean is not None else (math.nan, math.nan)
+    n_eff = belief.n_eff if belief.n_eff is not None else math.nan
+    return (tick.step, tick.time, p.x, p.y, p.theta, e.x, e.y, e.theta, *seen, *mean, n_eff, rate)
+
+
+def row_columns(rows: list[tuple]) -> dict[str, np.ndarray]:
+    """Buffered :func:`tick_row` rows as one float array per :data:`ROW` name."""
+    return dict(zip(ROW, np.array(rows, dtype=float).T))
+
+
+class EntityBuffer:
+    """Rows of one entity waiting to be sent with ``send_columns``.
+
+    A row is one tick's step and time and, per component, one value per instance: a
+    numeric array of shape (n, ...), a list of n strings, or (for ``strips``) a list of
+    n (K, 3) arrays. ``kind`` is the archetype (``rr.Points3D``, ``rr.TextLog``, ...).
+    """
+
+    def __init__(self, path: str, kind: type) -> None:
+        self.path, self.kind = path, kind
+        self.steps: list[int] = []
+        self.times: list[float] = []
+        self.sizes: list[int] = []
+        self.values: dict[str, list] = {}
+
+    def add(self, step: int, time: float, **values) -> None:
+        self.steps.append(step)
+        self.times.append(time)
+        self.sizes.append(len(next(iter(values.values()))))
+        for key, value in values.items():
+            self.values.setdefault(key, []).append(value)
+
+    def send(self, rec: rr.RecordingStream, indexes: dict) -> None:
+        """Send the buffered rows as one chunk and empty the buffer; ``indexes`` caches
+        time columns (see :func:`time_index`)."""
+        if not self.steps:
+            return
+        columns = {key: _concatenate(key, parts) for key, parts in self.values.items()}
+        index = time_index(indexes, np.asarray(self.steps, dtype=np.int64), np.asarray(self.times))
+        columns = self.kind.columns(**columns).partition(self.sizes)
+        rec.send_columns(self.path, indexes=index, columns=columns, strict=True)
+        self.steps, self.times, self.sizes, self.values = [], [], [], {}
+
+
+def _concatenate(key: str, parts: list) -> Any:
+    """One component's values over rows (see :class:`EntityBuffer`)."""
+    if key == "strips":
+        return strips_array([strip for part in parts for strip in part])
+    if isinstance(parts[0], list):
+        return [item for part in parts for item in part]
+    return np.concatenate(parts)
+
+
+def time_index(cache: dict, steps: np.ndarray, times: np.ndarray) -> list:
+    """The ``step`` and ``sim_time`` index columns of rows at ``steps`` and ``times`` (s),
+    cached by steps: most entities have a row at every tick, and building them is not free."""
+    key = steps.tobytes()
+    if key not in cache:
+        # Whole nanoseconds, rounded as set_time rounds them (rerun-sdk would truncate).
+        nanos = np.round(times * 1e9).astype(np.int64).astype("timedelta64[ns]")
+        cache[key] = [rr.TimeColumn(STEP, sequence=steps), rr.TimeColumn(SIM_TIME, duration=nanos)]
+    return cache[key]
+
+
+def strips_array(strips) -> pa.ListArray:
+    """LineStrip3D arrow array of float32 strips: a list of (K, 3) arrays or an (n, K, 3)
+    array. Built in one go: rerun-sdk's own conversion loops over the strips in Python."""
+    if isinstance(strips, np.ndarray):
+        n, k = strips.shape[:2]
+        flat = strips.reshape(n * k, 3)
+        offsets = np.arange(0, (n + 1) * k, k, dtype=np.int32) if k else np.zeros(n + 1, np.int32)
+    else:
+        lengths = [len(strip) for strip in strips]
+        flat = np.concatenate(strips) if lengths else np.zeros((0, 3), np.float32)
+        offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
+        offsets[1:] = np.cumsum(lengths)
+    points = rr.encodings.Vec3DBatch(flat).as_arrow_array()
+    strip_type = pa.list_(pa.field("item", points.type, nullable=False))
+    return pa.ListArray.from_arrays(pa.array(offsets), points, type=strip_type)
+
+
+def stack_points(x: np.ndarray, y: np.ndarray, z) -> np.ndarray:
+    """(n, 3) float32 points from coordinates (m); z is an array or one height."""
+    out = np.empty((len(x), 3), dtype=np.float32)
+    out[:, 0], out[:, 1], out[:, 2] = x, y, z
+    return out
+
+
+def points_at(xy, z: float) -> np.ndarray:
+    """(n, 3) float32 points at height z (m) from (n, 2) map-frame positions (m); copies."""
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    return stack_points(xy[:, 0], xy[:, 1], z)
+
+
+class ParticleRows:
+    """The particle subsamples of up to ``capacity`` ticks, at most ``limit`` particles per
+    tick (an evenly strided subsample), in arrays allocated once: map-frame positions (m)
+    as float32 points at height ``z``, and their weights (NaN where the estimator gives
+    none)."""
+
+    def __init__(self, capacity: int, limit: int, z: float) -> None:
+        self.limit = limit
+        self.xyz = np.full((capacity, limit, 3), z, dtype=np.float32)
+        self.weights = np.zeros((capacity, limit))
+        self.sizes = np.zeros(capacity, dtype=np.int64)
+        self.steps = np.zeros(capacity, dtype=np.int64)
+        self.times = np.zeros(capacity)
+        self.count = 0
+        self.started = False  # rows begin at the first tick with particles
+
+    def add(self, step: int, time: float, particles: np.ndarray | None, weights: np.ndarray | None) -> None:
+        """A row of (N, >= 2) particles and their (N,) weights; None gives an empty row,
+        which clears the particles shown, once there have been some."""
+        if particles is None and not self.started:
+            return
+        self.started = True
+        row, size = self.count, 0
+        if particles is not None:
+            stride = -(-len(particles) // self.limit) or 1
+            size = -(-len(particles) // stride)
+            self.xyz[row, :size, :2] = particles[::stride, :2]
+            self.weights[row, :size] = np.nan if weights is None else weights[::stride]
+        self.sizes[row], self.steps[row], self.times[row] = size, step, time
+        self.count += 1
+
+    def take(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Empty the rows: (steps (T,), times (T,) s, positions (M, 3), shades (M,) uint8,
+        sizes (T,)), the rows' particles one after the other. A shade is 255 * the weight
+        over its tick's largest weight, rounded; 128 where the weight is NaN."""
+        n, self.count = self.count, 0
+        sizes, weights = self.sizes[:n].copy(), self.weights[:n]
+        held = np.arange(self.limit) < sizes[:, None]
+        unknown = held & np.isnan(weights)
+        top = np.max(np.where(held & ~unknown, weights, 0.0), axis=1, keepdims=True)
+        scale = np.divide(255.0, top, out=np.zeros_like(top), where=top > 0)
+        shades = np.clip(np.where(unknown, 0.0, weights) * scale + 0.5, 0, 255).astype(np.uint8)
+        shades[unknown] = 128
+        kept = np.flatnonzero(held)  # take() copies rows several times faster than a bool mask
+        positions = np.take(self.xyz[:n].reshape(-1, 3), kept, axis=0)
+        return self.steps[:n].copy(), self.times[:n].copy(), positions, shades.ravel()[kept], sizes
