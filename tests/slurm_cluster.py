@@ -59,9 +59,9 @@ class SlurmCluster:
         )
 
     def logs(self, lines: int = 20) -> str:
-        """The last ``lines`` lines of every daemon's log, for failure messages."""
+        """The last ``lines`` lines of every daemon's log file and captured output."""
         parts = []
-        for log in sorted(self.root.glob("*.log")):
+        for log in sorted([*self.root.glob("*.log"), *self.root.glob("*.out")]):
             tail = log.read_text(errors="replace").splitlines()[-lines:]
             parts.append(f"--- {log.name}\n" + "\n".join(tail))
         return "\n".join(parts)
@@ -80,23 +80,27 @@ class SlurmCluster:
                 process.wait(timeout=5)
 
 
+def _which(name: str) -> str | None:
+    """Where ``name`` is on ``PATH`` or in sbin (where Debian puts the daemons)."""
+    search = os.pathsep.join([os.environ.get("PATH", ""), "/usr/sbin", "/sbin"])
+    return shutil.which(name, path=search)
+
+
 def missing_executables() -> list[str]:
-    """The executables of :data:`EXECUTABLES` that are not on ``PATH`` (nor in sbin)."""
-    path = os.pathsep.join([os.environ.get("PATH", ""), "/usr/sbin", "/sbin"])
-    return [name for name in EXECUTABLES if shutil.which(name, path=path) is None]
+    """The executables of :data:`EXECUTABLES` that are not installed."""
+    return [name for name in EXECUTABLES if _which(name) is None]
 
 
-def _which(name: str) -> str:
-    path = os.pathsep.join([os.environ.get("PATH", ""), "/usr/sbin", "/sbin"])
-    found = shutil.which(name, path=path)
-    assert found is not None, name
-    return found
-
-
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
+def _free_ports(count: int) -> list[int]:
+    """``count`` distinct TCP ports free on this host now (held together while chosen)."""
+    probes = [socket.socket() for _ in range(count)]
+    try:
+        for probe in probes:
+            probe.bind(("127.0.0.1", 0))
+        return [probe.getsockname()[1] for probe in probes]
+    finally:
+        for probe in probes:
+            probe.close()
 
 
 def _node_hardware() -> tuple[int, int]:
@@ -112,17 +116,21 @@ def _node_hardware() -> tuple[int, int]:
 
 
 def slurm_conf(root: Path, node: str, cpus: int, memory_mib: int, partition: str) -> str:
-    """A minimal slurm.conf for one node (this host) that runs everything as root.
+    """A minimal slurm.conf for one node (this host, all its cores and memory), run as root.
 
-    The plugins are the ones that need nothing from the host: process tracking by the
-    parent pid (no cgroup mounts), no task binding, no accounting storage; cores and
-    memory are consumable so that jobs asking for one core run side by side.
+    Everything the daemons keep (state, spool, pid and log files, munge's socket) lives
+    under ``root``, and they listen on free ports, so a real Slurm on the host is not
+    disturbed. The plugins are the ones that need nothing from the host: processes are
+    tracked by parent pid (no cgroup mounts), tasks are not bound to cores, and there is
+    no accounting storage (no slurmdbd). Cores and memory are consumable resources, so
+    one-core jobs (the sweep's array tasks) run side by side, one per core.
     """
+    ctld_port, slurmd_port = _free_ports(2)  # not 6817/6818: a real Slurm may run here
     return f"""\
 ClusterName=pegame-test
 SlurmctldHost={node}(127.0.0.1)
-SlurmctldPort={_free_port()}
-SlurmdPort={_free_port()}
+SlurmctldPort={ctld_port}
+SlurmdPort={slurmd_port}
 SlurmUser=root
 SlurmdUser=root
 AuthType=auth/munge
@@ -134,8 +142,6 @@ SlurmctldPidFile={root / "slurmctld.pid"}
 SlurmdPidFile={root / "slurmd.pid"}
 SlurmctldLogFile={root / "slurmctld.log"}
 SlurmdLogFile={root / "slurmd.log"}
-SlurmctldDebug=info
-SlurmdDebug=info
 ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 SelectType=select/cons_tres
@@ -168,17 +174,12 @@ def _wait_for(cluster: SlurmCluster, what: str, ready, timeout_s: float) -> None
         dead = [n for n, p in cluster.processes.items() if p.poll() is not None]
         if dead:
             raise SlurmUnavailable(
-                f"{', '.join(dead)} exited while waiting for {what}:\n{_outputs(cluster)}"
+                f"{', '.join(dead)} exited while waiting for {what}:\n{cluster.logs()}"
             )
         time.sleep(0.5)
-    raise SlurmUnavailable(f"timed out after {timeout_s:.0f} s waiting for {what}:\n{_outputs(cluster)}")
-
-
-def _outputs(cluster: SlurmCluster) -> str:
-    parts = [cluster.logs()]
-    for out in sorted(cluster.root.glob("*.out")):
-        parts.append(f"--- {out.name}\n" + out.read_text(errors="replace")[-2000:])
-    return "\n".join(parts)
+    raise SlurmUnavailable(
+        f"timed out after {timeout_s:.0f} s waiting for {what}:\n{cluster.logs()}"
+    )
 
 
 def start_cluster(root: Path, timeout_s: float = 60.0) -> SlurmCluster:
@@ -197,6 +198,8 @@ def start_cluster(root: Path, timeout_s: float = 60.0) -> SlurmCluster:
         )
     if os.geteuid() != 0:
         raise SlurmUnavailable("the test cluster runs its daemons as root; this is not root")
+    if len(str(root / "munge.socket")) > 100:  # sun_path holds 108 bytes
+        raise SlurmUnavailable(f"{root} is too long a path for munged's socket")
     root.mkdir(parents=True, exist_ok=True)
     root.chmod(0o700)  # munged refuses a socket or key in a directory others can write
     for sub in ("state", "spool"):
@@ -209,6 +212,8 @@ def start_cluster(root: Path, timeout_s: float = 60.0) -> SlurmCluster:
     key.write_bytes(os.urandom(1024))
     key.chmod(0o600)
     try:
+        # --force: munged would refuse a key or socket below a directory others can write
+        # (a custom --basetemp, say); this key guards a throwaway cluster.
         _start(
             cluster, "munged", _which("munged"), "--foreground", "--force",
             f"--socket={root / 'munge.socket'}", f"--key-file={key}",
