@@ -15,13 +15,15 @@ import json
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 from slurm_cluster import SlurmCluster, SlurmUnavailable, start_cluster
 
-# The daemons and the sweep take both cores: keep these tests on one xdist worker.
+# One cluster at a time, and the sweeps want both cores: under pytest-xdist
+# (--dist loadgroup) these tests share one worker.
 pytestmark = pytest.mark.xdist_group("slurm")
 
 #: A reduced Table 1 sweep: 2 maps x 2 pairings, 3 short games per cell.
@@ -36,11 +38,11 @@ SWEEP = (
 )
 CELLS = 2 * 2
 GAMES_PER_CELL = 3
-SWEEP_TIMEOUT_S = 180.0  # the sweep takes ~15 s here; a stuck array must not hang CI
+SWEEP_TIMEOUT_S = 180.0  # each sweep takes 15-45 s on 2 busy cores; a stuck array must not hang CI
 
 
 @pytest.fixture(scope="module")
-def slurm(tmp_path_factory) -> SlurmCluster:
+def slurm(tmp_path_factory) -> Iterator[SlurmCluster]:
     """A one-node Slurm cluster for this module, stopped when the module's tests end."""
     pytest.importorskip("hydra_plugins.hydra_submitit_launcher")
     try:
