@@ -181,6 +181,24 @@ def test_region_over_a_block_equals_the_whole_mask_there(seed):
     assert partial > 20  # most blocks needed only part of the region
 
 
+@pytest.mark.parametrize("theta", [math.pi, -math.pi, math.nextafter(math.pi, 0.0),
+                                   math.nextafter(-math.pi, 0.0), 3 * math.pi])
+def test_region_over_a_block_is_exact_where_bearings_wrap_at_pi(theta):
+    # The rays reaching a block are found from bearings wrapped to (-pi, pi] (the one angle
+    # wrap of pegame.trig); a camera looking along -x at blocks around that bearing puts
+    # the bearings on both sides of the seam.
+    grid = empty_grid(60, 60, 0.1)
+    pose = Pose(5.0, 3.0, theta)
+    camera = Camera(fov=0.8, near=0.0, far=4.5, angle_step=0.004, distance_step=0.05)
+    whole = visibility_region(grid, pose, camera)
+    for top in range(20, 40, 3):
+        for left in (2, 10, 20, 35):
+            over = VisibilityRegion(grid, pose, camera).mask_over((top, top + 2), (left, left + 3))
+            block = np.s_[top : top + 3, left : left + 4]
+            assert np.array_equal(over[block], whole[block])
+    assert whole[30, 20] and not whole[30, 55]
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_region_holds_exactly_the_mask_cells_asked_about(seed):
     # Clouds of cells around random points, some in view and some behind the camera or out

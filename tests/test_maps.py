@@ -209,6 +209,19 @@ def test_save_errors(tmp_path, target, image_format):
         save_map(OccupancyGrid(np.zeros((2, 2)), 0.05), path, image_format=image_format)
 
 
+def test_save_writes_shared_files_atomically(tmp_path):
+    # save_map writes through pegame.files.write_atomic: files readable by all, and a
+    # failed write leaves no temporary file behind.
+    save_map(OccupancyGrid(np.zeros((2, 2)), 0.05), tmp_path / "ok.yaml")
+    assert {(p.name, p.stat().st_mode & 0o777) for p in tmp_path.iterdir()} == {
+        ("ok.pgm", 0o644), ("ok.yaml", 0o644)
+    }
+    (tmp_path / "dir.yaml").mkdir()  # the YAML cannot replace a directory
+    with pytest.raises(MapError, match="cannot write"):
+        save_map(OccupancyGrid(np.zeros((2, 2)), 0.05), tmp_path / "dir.yaml")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dir.pgm", "dir.yaml", "ok.pgm", "ok.yaml"]
+
+
 # --------------------------------------------------------------------------- frames
 
 
