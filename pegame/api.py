@@ -32,6 +32,7 @@ from pegame.types import (
     Detection,
     Plan,
     Pose,
+    Region,
     SensorFrame,
     Velocity,
     clamp,
@@ -40,12 +41,11 @@ from pegame.types import (
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from pegame.grid import OccupancyGrid
-    from pegame.visibility import VisibilityRegion
 
 __all__ = [
     "EMPTY_BELIEF", "STOP", "Belief", "Body", "BoundingBox", "Camera", "Context", "Detection",
     "Detector", "Estimator", "Evader", "EvaderObservation", "INTERFACES", "Plan", "Plugin",
-    "Pose", "Pursuer", "PursuerObservation", "Recorder", "SensorFrame", "Simulator",
+    "Pose", "Pursuer", "PursuerObservation", "Recorder", "Region", "SensorFrame", "Simulator",
     "Strategy", "Tick", "Velocity", "clamp", "wrap_angle",
 ]
 
@@ -64,7 +64,7 @@ class PursuerObservation:
     pose: Pose
     detection: Detection | None
     belief: Belief
-    region: VisibilityRegion
+    region: Region
 
 
 @dataclass(frozen=True)
@@ -79,7 +79,7 @@ class EvaderObservation:
     time: float
     pose: Pose
     pursuer: Pose
-    pursuer_region: VisibilityRegion | None = None
+    pursuer_region: Region | None = None
 
 
 @dataclass(frozen=True)
@@ -115,7 +115,7 @@ class Tick:
     frame: SensorFrame
     detection: Detection | None
     belief: Belief
-    region: VisibilityRegion | None
+    region: Region | None
     in_view: bool
     commands: tuple[Velocity, Velocity]
     plans: tuple[Plan, Plan]
@@ -187,12 +187,12 @@ class Estimator(Plugin):
     """
 
     @abstractmethod
-    def reset(self, pursuer: Pose, detection: Detection | None, region: VisibilityRegion) -> Belief:
+    def reset(self, pursuer: Pose, detection: Detection | None, region: Region) -> Belief:
         """Start a new game; the evader is in view at the start (the paper's protocol)."""
 
     @abstractmethod
     def update(
-        self, dt: float, pursuer: Pose, detection: Detection | None, region: VisibilityRegion
+        self, dt: float, pursuer: Pose, detection: Detection | None, region: Region
     ) -> Belief:
         """Predict dt seconds (s) ahead and correct with this tick's detection (or its
         absence) and the pursuer's visibility region (``region.mask`` is a bool (H, W) mask

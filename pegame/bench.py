@@ -29,7 +29,7 @@ from pegame.api import Context, EvaderObservation, PursuerObservation
 from pegame.types import Body, Camera, Pose
 from pegame.config import compose, resolve_map_path
 from pegame.game import Game
-from pegame.visibility import VisibilityRegion, visibility_region
+from pegame.visibility import MaskRegion, VisibilityRegion, visibility_region
 from pegame.grid import OccupancyGrid, load_map
 from pegame.navigation import Planner
 
@@ -131,7 +131,7 @@ def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]
         p0 = pairs[0][0]
         pf.reset(p0, None, VisibilityRegion(grid, p0, camera))
         # Regions computed beforehand: the step is timed without its visibility region.
-        masks = [VisibilityRegion.given(visibility_region(grid, p, camera)) for p, _ in pairs]
+        masks = [MaskRegion(visibility_region(grid, p, camera)) for p, _ in pairs]
         it = iter(list(zip(pairs, masks)) * 2)
 
         def pf_step():

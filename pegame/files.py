@@ -1,4 +1,4 @@
-"""Atomic and append-only result files: a reader never sees a half-written file."""
+"""Atomic file writes (results, figures, map files): a reader never sees a half-written file."""
 
 from __future__ import annotations
 

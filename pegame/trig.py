@@ -1,4 +1,6 @@
-"""Sine and cosine of one angle as a branch-free polynomial, for loops that numba vectorises.
+"""Angle arithmetic for numba kernels: a vectorisable sine-cosine and the angle wrap.
+
+Sine and cosine of one angle as a branch-free polynomial, for loops that numba vectorises.
 
 libm's sin and cos branch on the argument's size, so a numba loop that calls them runs
 one angle at a time (about 9 ns per sin-cos pair here). :func:`sin_cos` reduces the
@@ -10,6 +12,14 @@ over an array, LLVM turns it into SIMD code: about four times faster than libm f
 angles. For |angle| <= MAX_ANGLE rad the results differ from libm's by at most 2^-52
 (one ulp of 1; the tests hold it to that); beyond, the reduction loses accuracy and
 callers must use libm.
+
+The angle wrap onto (-pi, pi] is defined once, as numpy computes ``pi - ((pi - angle) mod
+2 pi)`` (:func:`wrap_angles_reference`): :func:`wrap_angle_kernel` is that for one angle in
+numba code, bit for bit and mostly without the slow fmod, and :func:`wrap_angles` is the
+same kernel as a numpy ufunc for arrays. (The rounded modulo can reach 2 pi, so an angle
+within an ulp above an odd multiple of pi wraps to -pi.) :func:`pegame.types.wrap_angle`
+(Python floats, the exact IEEE remainder) rounds differently, by a few ulps of pi, and is
+kept apart so that no result of the code that uses it changes.
 """
 
 from __future__ import annotations
@@ -17,7 +27,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, vectorize
 
 #: rad; the largest |angle| for which :func:`sin_cos` is accurate (2^20 pi/2, as in fdlibm)
 MAX_ANGLE = 2.0**20 * math.pi / 2.0
@@ -46,3 +56,40 @@ def sin_cos(angle):
     sin_sign = 1.0 - 2.0 * ((q >> 1) & 1)
     cos_sign = 1.0 - 2.0 * (((q + 1) >> 1) & 1)
     return (c if swap else s) * sin_sign, (s if swap else c) * cos_sign
+
+
+def wrap_angles_reference(angles):
+    """Angles (rad, array or scalar) wrapped to (-pi, pi] (module docstring): ``pi - ((pi -
+    angles) mod 2 pi)`` with numpy's floored modulo; the definition that
+    :func:`wrap_angle_kernel` follows."""
+    return np.pi - np.mod(np.pi - angles, 2.0 * np.pi)
+
+
+@njit(cache=True)
+def wrap_angle_kernel(angle):
+    """:func:`wrap_angles_reference` of one angle (rad), bit for bit, mostly without fmod
+    (slow in libm).
+
+    numpy's remainder r = (pi - angle) mod 2 pi is fmod(y, 2 pi) for y = pi - angle, plus
+    2 pi when that is negative (+0 when it is zero). For -2 pi < y < 4 pi the fmod is y
+    or y - 2 pi, exact by Sterbenz's lemma, and the addition is the same float operation
+    numpy does; other angles take the general remainder.
+    """
+    y = math.pi - angle
+    period = 2.0 * math.pi
+    if 0.0 < y < period:
+        remainder = y
+    elif period <= y < 2.0 * period:
+        remainder = y - period
+    elif -period < y < 0.0:
+        remainder = y + period
+    else:
+        remainder = y % period
+    return math.pi - remainder
+
+
+@vectorize(["float64(float64)"], cache=True)
+def wrap_angles(angles):
+    """Angles (rad, float64 array or scalar) wrapped to (-pi, pi]: :func:`wrap_angle_kernel`
+    elementwise, so bit for bit :func:`wrap_angles_reference` (and about twice as fast)."""
+    return wrap_angle_kernel(angles)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -194,3 +194,28 @@ class Plan:
     goal: tuple[float, float] | None = None
     path: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     info: dict[str, Any] = field(default_factory=dict)
+
+
+class Region(Protocol):
+    """A set of grid cells: the pursuer's visibility region V^p_k as observations carry it.
+
+    shape: (H, W) of the grid. mask: bool (H, W), True on the cells of the region,
+    read-only (possibly computed at the first read). bounds: (r0, r1, c0, c1), rows
+    [r0, r1) and columns [c0, c1) hold every cell of the region (r1 <= r0 when it is
+    empty). holds(cells): bool (N,), whether the region holds each flat cell index of the
+    int (N,) array ``cells`` (row * width + col; negative: no cell, False), possibly
+    without computing the whole mask. Implemented by :class:`pegame.visibility.
+    VisibilityRegion` (Algorithm 1, on demand) and :class:`pegame.visibility.MaskRegion`
+    (a given mask, for sensors that see otherwise and for tests).
+    """
+
+    @property
+    def shape(self) -> tuple[int, ...]: ...
+
+    @property
+    def mask(self) -> np.ndarray: ...
+
+    @property
+    def bounds(self) -> tuple[int, int, int, int]: ...
+
+    def holds(self, cells: np.ndarray) -> np.ndarray: ...

@@ -15,10 +15,10 @@ from pegame import registry
 from pegame.api import Context
 from pegame.types import Body, BoundingBox, Camera, Detection, Pose
 from pegame.errors import ConfigError
-from pegame.visibility import VisibilityRegion
+from pegame.visibility import MaskRegion, VisibilityRegion
 from pegame.estimators.kalman import KalmanEstimator
 from pegame.estimators.last_seen import LastSeen
-from pegame.estimators.particle_filter import ParticleFilter, _wrap_angle, wrap
+from pegame.estimators.particle_filter import ParticleFilter
 from pegame.estimators.resampling import RESAMPLERS
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 
@@ -65,7 +65,7 @@ def disc(grid, center, radius):
     """The region of the cells whose centre lies within ``radius`` m of ``center``."""
     rows, cols = np.mgrid[0 : grid.height, 0 : grid.width]
     x, y = grid.cell_to_world(rows, cols)
-    return VisibilityRegion.given((x - center[0]) ** 2 + (y - center[1]) ** 2 <= radius**2)
+    return MaskRegion((x - center[0]) ** 2 + (y - center[1]) ** 2 <= radius**2)
 
 
 def cell_values(grid, particles, mask):
@@ -318,17 +318,6 @@ def test_motion_kernel_matches_the_reference_beyond_the_polynomial_range():
     assert_same_belief(fast.update(DT, PURSUER, start, view), slow.update_reference(DT, PURSUER, start, view))
 
 
-def test_wrap_kernel_matches_numpy():
-    period = 2.0 * math.pi
-    edges = [0.0, -0.0, math.pi, -math.pi, period, -period, 2 * period, -2 * period,
-             3 * math.pi, -3 * math.pi, 1e300, -1e300, math.inf, -math.inf, math.nan]
-    edges += [np.nextafter(v, d) for v in edges[:10] for d in (math.inf, -math.inf)]
-    angles = np.concatenate([edges, np.random.default_rng(30).uniform(-20.0, 20.0, 20000)])
-    ours = np.array([_wrap_angle(a) for a in angles])
-    with np.errstate(invalid="ignore"):
-        theirs = wrap(angles)
-    np.testing.assert_array_equal(ours, theirs)  # NaNs compare equal here
-    assert np.array_equal(np.signbit(ours), np.signbit(theirs))
 
 
 def test_vanished_weights_reinitialise_outside_the_view(caplog):
@@ -345,7 +334,7 @@ def test_vanished_weights_reinitialise_outside_the_view(caplog):
     assert np.all(on_free(grid, belief.particles))
     assert not np.any(cell_values(grid, belief.particles, view.mask))
     # A region over the whole grid: no free cell is left outside it.
-    everywhere = VisibilityRegion.given(np.ones((grid.height, grid.width), dtype=bool))
+    everywhere = MaskRegion(np.ones((grid.height, grid.width), dtype=bool))
     pf.reset(PURSUER, detection(1.5, 2.0), everywhere)
     belief = pf.update(DT, PURSUER, None, everywhere)
     assert np.all(on_free(grid, belief.particles)) and np.all(np.isfinite(belief.weights))
@@ -396,7 +385,7 @@ def test_reset_without_detection_covers_the_visible_free_cells():
     view = disc(grid, (3.0, 2.0), 1.0)  # straddles the block
     belief = pf.reset(PURSUER, None, view)
     assert np.all(cell_values(grid, belief.particles, view.mask & grid.free))
-    nothing = VisibilityRegion.given(np.zeros((grid.height, grid.width), dtype=bool))
+    nothing = MaskRegion(np.zeros((grid.height, grid.width), dtype=bool))
     belief = pf.reset(PURSUER, None, nothing)
     assert np.all(on_free(grid, belief.particles))
     assert np.ptp(belief.particles[:, 0]) > 3.5  # spread over the whole room
@@ -425,7 +414,7 @@ def test_visibility_mask_of_the_wrong_shape_is_rejected():
     grid = room()
     pf = build(ParticleFilter, grid, n_particles=10)
     with pytest.raises(ValueError, match="shape"):
-        pf.reset(PURSUER, None, VisibilityRegion.given(np.ones((3, 3), dtype=bool)))
+        pf.reset(PURSUER, None, MaskRegion(np.ones((3, 3), dtype=bool)))
 
 
 # --------------------------------------------------------------------------- kalman

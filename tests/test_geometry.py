@@ -9,19 +9,20 @@ import pytest
 from scipy.ndimage import binary_dilation
 
 from pegame.types import Camera, Pose
+from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, point_cell
+from pegame.types import Region
 from pegame.visibility import (
+    MaskRegion,
     VisibilityRegion,
     body_in_view,
-    _line_of_sight_reference,
-    _ray_tables,
     fov_wedge,
     in_view,
     line_of_sight,
-    point_cell,
     visibility_region,
     visibility_region_reference,
 )
-from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from pegame.visibility.rays import directions, ray_tables
+from pegame.visibility.sight import _line_of_sight_reference
 
 CAMERA = Camera(fov=math.pi / 3, near=0.3, far=3.0, angle_step=0.0016, distance_step=0.05)
 BOTH = [visibility_region, visibility_region_reference]
@@ -71,7 +72,7 @@ def polar(grid, pose, rows, cols):
 
 
 def test_ray_tables_span_fov_and_range_inclusively():
-    angles, distances, first = _ray_tables(CAMERA)
+    angles, distances, first = ray_tables(CAMERA)
     assert angles[0] == -CAMERA.fov / 2 and angles[-1] == CAMERA.fov / 2
     assert np.all(np.diff(angles) > 0) and np.all(np.diff(angles) <= CAMERA.angle_step + 1e-12)
     assert distances[0] == 0.0 and distances[-1] == CAMERA.far
@@ -180,6 +181,24 @@ def test_region_over_a_block_equals_the_whole_mask_there(seed):
     assert partial > 20  # most blocks needed only part of the region
 
 
+@pytest.mark.parametrize("theta", [math.pi, -math.pi, math.nextafter(math.pi, 0.0),
+                                   math.nextafter(-math.pi, 0.0), 3 * math.pi])
+def test_region_over_a_block_is_exact_where_bearings_wrap_at_pi(theta):
+    # The rays reaching a block are found from bearings wrapped to (-pi, pi] (the one angle
+    # wrap of pegame.trig); a camera looking along -x at blocks around that bearing puts
+    # the bearings on both sides of the seam.
+    grid = empty_grid(60, 60, 0.1)
+    pose = Pose(5.0, 3.0, theta)
+    camera = Camera(fov=0.8, near=0.0, far=4.5, angle_step=0.004, distance_step=0.05)
+    whole = visibility_region(grid, pose, camera)
+    for top in range(20, 40, 3):
+        for left in (2, 10, 20, 35):
+            over = VisibilityRegion(grid, pose, camera).mask_over((top, top + 2), (left, left + 3))
+            block = np.s_[top : top + 3, left : left + 4]
+            assert np.array_equal(over[block], whole[block])
+    assert whole[30, 20] and not whole[30, 55]
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_region_holds_exactly_the_mask_cells_asked_about(seed):
     # Clouds of cells around random points, some in view and some behind the camera or out
@@ -198,8 +217,8 @@ def test_region_holds_exactly_the_mask_cells_asked_about(seed):
         expected = np.where(cells >= 0, whole[np.maximum(cells, 0)], False)
         region = VisibilityRegion(grid, pose, camera)
         assert np.array_equal(region.holds(cells), expected)
-        skipped += region._mask is None
-        assert np.array_equal(VisibilityRegion.given(whole.reshape(60, 60)).holds(cells), expected)
+        skipped += region._whole is None
+        assert np.array_equal(MaskRegion(whole.reshape(60, 60)).holds(cells), expected)
     assert skipped == 40  # the whole mask was never needed
 
 
@@ -212,7 +231,7 @@ def test_region_bounds_hold_exactly_its_cells(seed):
     for _ in range(40):
         region = VisibilityRegion(grid, random_free_pose(rng, grid), random_camera(rng))
         rows, cols = np.nonzero(region.mask)
-        given = VisibilityRegion.given(region.mask).bounds
+        given = MaskRegion(region.mask).bounds
         if rows.size:
             expected = (rows.min(), rows.max() + 1, cols.min(), cols.max() + 1)
             assert region.bounds == expected and given == expected
@@ -231,8 +250,28 @@ def test_region_mask_is_computed_once_and_read_only():
     assert region.mask is mask and not mask.flags.writeable
     assert np.array_equal(mask, visibility_region(grid, Pose(2.0, 2.0, 0.3), CAMERA))
     assert region.mask_over((0, 0), (0, 0)) is mask  # once whole, always whole
-    given = VisibilityRegion.given(np.eye(3, dtype=bool))
-    assert given.shape == (3, 3) and given.mask_over((0, 0), (0, 0)) is given.mask
+    given = MaskRegion(np.eye(3, dtype=bool))
+    assert given.shape == (3, 3) and not given.mask.flags.writeable
+
+
+def test_both_regions_are_regions_and_agree():
+    # Observations name the Region protocol, not a kernel class: a region known by its mask
+    # is its own class (no VisibilityRegion with empty grid, pose and camera fields) and
+    # answers every question of the protocol as the computed region does.
+    members = [name for name in vars(Region) if not name.startswith("_")]
+    assert sorted(members) == ["bounds", "holds", "mask", "shape"]
+    grid = random_grid(np.random.default_rng(6), 40, 50, 0.1)
+    rng = np.random.default_rng(7)
+    for _ in range(10):
+        computed = VisibilityRegion(grid, random_free_pose(rng, grid), random_camera(rng))
+        given = MaskRegion(computed.mask.copy())
+        assert not hasattr(VisibilityRegion, "given") and not hasattr(given, "grid")
+        cells = rng.integers(-5, grid.data.size, 500)
+        assert given.shape == computed.shape == grid.data.shape
+        assert np.array_equal(given.mask, computed.mask)
+        assert np.array_equal(given.holds(cells), computed.holds(cells))
+        if computed.mask.any():
+            assert given.bounds == computed.bounds
 
 
 @pytest.mark.parametrize("region", BOTH)
@@ -438,10 +477,8 @@ def test_fov_wedge_is_a_closed_ring_on_the_range_limits(near):
 
 
 def test_ray_directions_are_libm_s_beyond_the_polynomial_range():
-    from pegame.visibility import _directions
-
     angles = np.linspace(-0.5, 0.5, 101)
     for theta in (0.3, -2.9, 1e7, -4e9):
-        cos_a, sin_a = _directions(theta, angles, 10, 90)
+        cos_a, sin_a = directions(theta, angles, 10, 90)
         np.testing.assert_allclose(cos_a, np.cos(theta + angles[10:90]), rtol=0, atol=2.3e-16)
         np.testing.assert_allclose(sin_a, np.sin(theta + angles[10:90]), rtol=0, atol=2.3e-16)

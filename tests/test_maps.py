@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import copy
+import gc
 import math
+import pickle
 import re
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +17,7 @@ from PIL import Image
 from scipy import ndimage
 
 from pegame.errors import MapError
-from pegame.grid import OccupancyGrid, load_map, save_map
+from pegame.grid import OccupancyGrid, load_map, per_grid, save_map
 
 MAPS_DIR = Path(__file__).resolve().parents[1] / "maps"
 
@@ -205,6 +209,19 @@ def test_save_errors(tmp_path, target, image_format):
         save_map(OccupancyGrid(np.zeros((2, 2)), 0.05), path, image_format=image_format)
 
 
+def test_save_writes_shared_files_atomically(tmp_path):
+    # save_map writes through pegame.files.write_atomic: files readable by all, and a
+    # failed write leaves no temporary file behind.
+    save_map(OccupancyGrid(np.zeros((2, 2)), 0.05), tmp_path / "ok.yaml")
+    assert {(p.name, p.stat().st_mode & 0o777) for p in tmp_path.iterdir()} == {
+        ("ok.pgm", 0o644), ("ok.yaml", 0o644)
+    }
+    (tmp_path / "dir.yaml").mkdir()  # the YAML cannot replace a directory
+    with pytest.raises(MapError, match="cannot write"):
+        save_map(OccupancyGrid(np.zeros((2, 2)), 0.05), tmp_path / "dir.yaml")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dir.pgm", "dir.yaml", "ok.pgm", "ok.yaml"]
+
+
 # --------------------------------------------------------------------------- frames
 
 
@@ -385,3 +402,29 @@ def test_world_to_cell_of_scalars_equals_that_of_arrays(origin):
     scalar = [grid.world_to_cell(float(x), float(y)) for x, y in zip(xs, ys)]
     assert scalar == list(zip(rows.tolist(), cols.tolist()))
     assert all(type(v) is int for v in scalar[0])
+
+
+def test_per_grid_builds_once_per_grid_and_key():
+    calls = []
+
+    def build(grid):
+        calls.append(grid)
+        return np.zeros(1)
+
+    one, two = OccupancyGrid(np.zeros((3, 3)), 0.1), OccupancyGrid(np.zeros((3, 3)), 0.1)
+    first = per_grid(one, ("test", 1), build)
+    assert per_grid(one, ("test", 1), build) is first and calls == [one]
+    assert per_grid(one, ("test", 2), build) is not first
+    assert per_grid(two, ("test", 1), build) is not first
+    assert calls == [one, one, two]
+
+
+def test_per_grid_cache_lives_and_dies_with_its_grid():
+    grid = OccupancyGrid(np.zeros((3, 3)), 0.1)
+    held = per_grid(grid, ("test",), lambda g: [g])  # the cached object refers to its grid
+    for copied in (pickle.loads(pickle.dumps(grid)), copy.deepcopy(grid)):
+        assert per_grid(copied, ("test",), lambda g: [g])[0] is copied  # rebuilt, not copied
+    alive = weakref.ref(grid)
+    del grid, held
+    gc.collect()
+    assert alive() is None

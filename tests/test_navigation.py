@@ -16,13 +16,11 @@ from pegame.navigation import (
     LARGE_GRID_LANDMARKS,
     PathFollower,
     Planner,
-    _astar_reference,
-    _distance_field_reference,
-    _follow,
-    _follow_reference,
     inflate,
     shared_inflation,
 )
+from pegame.navigation.follower import _follow, _follow_reference
+from pegame.navigation.search import astar_reference, distance_field_reference
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 SEEDS = [0, 1, 2, 3, 4]
@@ -140,7 +138,7 @@ def test_distance_field_matches_reference_and_bellman_ford(seed, weighted):
         assert field.shape == grid.data.shape and field.dtype == np.float64
         source = grid.world_to_cell(*xy)
         args = (planner.traversable, planner.multipliers, weighted, grid.resolution, source)
-        reference = _distance_field_reference(*args)
+        reference = distance_field_reference(*args)
         brute = bellman_ford(*args)
         np.testing.assert_array_equal(np.isfinite(field), np.isfinite(brute))
         np.testing.assert_array_equal(np.isfinite(field), planner.reachable(xy))
@@ -161,7 +159,7 @@ def test_plans_are_clear_optimal_and_match_the_reference(seed, landmarks):
         s, g = grid.world_to_cell(*start), grid.world_to_cell(*goal)
         costs = bellman_ford(planner.traversable, planner.multipliers, True, grid.resolution, s)
         optimum = costs[g]
-        ref_cost, ref_cells = _astar_reference(
+        ref_cost, ref_cells = astar_reference(
             planner.traversable, planner.multipliers, grid.resolution, s, g
         )
         assert result.reachable == np.isfinite(optimum)

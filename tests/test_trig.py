@@ -1,4 +1,4 @@
-"""The vectorisable sin_cos against libm (through numpy)."""
+"""The vectorisable sin_cos against libm (through numpy), and the one angle wrap."""
 
 from __future__ import annotations
 
@@ -8,7 +8,10 @@ import numpy as np
 import pytest
 from numba import njit
 
-from pegame.trig import MAX_ANGLE, sin_cos
+from pegame.trig import (
+    MAX_ANGLE, sin_cos, wrap_angle_kernel, wrap_angles, wrap_angles_reference,
+)
+from pegame.types import wrap_angle
 
 
 @njit(cache=True)
@@ -30,3 +33,38 @@ def test_sin_cos_is_within_one_ulp_of_one_of_libm(limit):
     assert np.max(np.abs(sines - np.sin(angles))) <= tolerance
     assert np.max(np.abs(cosines - np.cos(angles))) <= tolerance
     assert sin_cos_of(np.array([0.0]))[0][0] == 0.0 and sin_cos_of(np.array([0.0]))[1][0] == 1.0
+
+
+def wrap_test_angles():
+    period = 2.0 * math.pi
+    edges = [0.0, -0.0, math.pi, -math.pi, period, -period, 2 * period, -2 * period,
+             3 * math.pi, -3 * math.pi, 1e300, -1e300, math.inf, -math.inf, math.nan]
+    edges += [np.nextafter(v, d) for v in edges[:10] for d in (math.inf, -math.inf)]
+    return np.concatenate([edges, np.random.default_rng(30).uniform(-20.0, 20.0, 20000)])
+
+
+def test_wrap_kernel_and_ufunc_equal_the_numpy_definition_bit_for_bit():
+    angles = wrap_test_angles()
+    with np.errstate(invalid="ignore"):  # inf and nan
+        theirs = wrap_angles_reference(angles)
+        vectorised = wrap_angles(angles)
+    for ours in (np.array([wrap_angle_kernel(a) for a in angles]), vectorised):
+        np.testing.assert_array_equal(ours, theirs)  # NaNs compare equal here
+        assert np.array_equal(np.signbit(ours), np.signbit(theirs))
+
+
+def test_wraps_land_in_minus_pi_to_pi_and_agree_with_the_scalar_wrap_within_ulps_of_pi():
+    angles = wrap_test_angles()
+    angles = angles[np.isfinite(angles) & (np.abs(angles) < 1e6)]
+    wrapped = wrap_angles(angles)
+    assert np.all((wrapped >= -math.pi) & (wrapped <= math.pi))
+    # -pi only where the modulo rounds up to 2 pi: just above an odd multiple of pi
+    odd = np.abs(angles[wrapped == -math.pi] - math.pi) % (2.0 * math.pi)
+    assert np.all(odd <= 4 * np.spacing(math.pi))
+    assert wrap_angles(-math.pi) == math.pi == wrap_angle(-math.pi)
+    # pegame.types.wrap_angle (exact IEEE remainder) is kept apart: it rounds differently.
+    scalar = np.array([wrap_angle(float(a)) for a in angles])
+    gap = np.abs(scalar - wrapped)
+    gap = np.minimum(gap, 2.0 * math.pi - gap)  # pi and -pi are the same angle
+    assert np.max(gap) <= 4 * np.spacing(math.pi) * (1 + np.abs(angles).max() / math.pi)
+

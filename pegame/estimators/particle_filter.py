@@ -64,7 +64,7 @@ from pegame.api import Estimator
 from pegame.types import Belief, Detection, Pose
 from pegame.errors import MapError, require
 from pegame.visibility import VisibilityRegion
-from pegame.trig import MAX_ANGLE, sin_cos
+from pegame.trig import MAX_ANGLE, sin_cos, wrap_angle_kernel, wrap_angles, wrap_angles_reference
 from pegame.estimators.resampling import RESAMPLERS, ThresholdResampler, effective_sample_size
 
 log = logging.getLogger(__name__)
@@ -77,34 +77,7 @@ RESEED_TRIES = 5
 NOISE_BATCH = 32
 
 
-def wrap(angles: np.ndarray) -> np.ndarray:
-    """Wrap angles (rad) to (-pi, pi]."""
-    return np.pi - np.mod(np.pi - angles, 2.0 * np.pi)
-
-
 # --------------------------------------------------------------------------- kernels
-
-
-@njit(cache=True)
-def _wrap_angle(angle):
-    """:func:`wrap` of one angle (rad), bit for bit, mostly without fmod (slow in libm).
-
-    numpy's remainder r = (pi - angle) mod 2 pi is fmod(y, 2 pi) for y = pi - angle, plus
-    2 pi when that is negative (+0 when it is zero). For -2 pi < y < 4 pi the fmod is y
-    or y - 2 pi, exact by Sterbenz's lemma, and the addition is the same float operation
-    numpy does; other angles take the general remainder.
-    """
-    y = math.pi - angle
-    period = 2.0 * math.pi
-    if 0.0 < y < period:
-        remainder = y
-    elif period <= y < 2.0 * period:
-        remainder = y - period
-    elif -period < y < 0.0:
-        remainder = y + period
-    else:
-        remainder = y % period
-    return math.pi - remainder
 
 
 @njit(cache=True)
@@ -142,7 +115,7 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
     for i in range(n):  # contiguous and branch-free, so vectorised
         sin_h[i], cos_h[i] = sin_cos(heading[i])
     for i in range(n):  # its own pass: the branches slow the passes above 2.5x
-        moved[i, 2] = _wrap_angle(moved[i, 2])
+        moved[i, 2] = wrap_angle_kernel(moved[i, 2])
     cells = np.empty(n, dtype=np.int64)
     ox, oy, res, rotate = frame.ox, frame.oy, frame.resolution, frame.rotated
     c, s = frame.cos_yaw, frame.sin_yaw
@@ -410,7 +383,7 @@ class ParticleFilter(Estimator):
             (
                 p[:, 0] + speed * dt * np.cos(heading),
                 p[:, 1] + speed * dt * np.sin(heading),
-                wrap(p[:, 2] + turn * dt),
+                wrap_angles_reference(p[:, 2] + turn * dt),
             )
         )
 
@@ -470,7 +443,7 @@ class ParticleFilter(Estimator):
         return np.column_stack((x, y, self._headings(n)))
 
     def _headings(self, n: int) -> np.ndarray:
-        return wrap(self.rng.uniform(-np.pi, np.pi, n))
+        return wrap_angles(self.rng.uniform(-np.pi, np.pi, n))
 
     # ------------------------------------------------------------------ grid lookups
 

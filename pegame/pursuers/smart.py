@@ -41,8 +41,7 @@ from numba import njit
 from pegame.api import Pursuer, PursuerObservation
 from pegame.types import Plan, Pose, Velocity, clamp, wrap_angle
 from pegame.errors import require
-from pegame.visibility import point_cell
-from pegame.grid import OccupancyGrid
+from pegame.grid import OccupancyGrid, point_cell
 from pegame.navigation import PathFollower, Planner, shared_inflation
 
 log = logging.getLogger(__name__)

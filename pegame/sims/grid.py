@@ -19,7 +19,7 @@ from numba import njit
 
 from pegame.api import Simulator
 from pegame.types import Body, Pose, SensorFrame, Velocity, wrap_angle
-from pegame.visibility import cell_blocked, point_cell
+from pegame.grid import cell_blocked, point_cell
 from pegame.navigation import shared_inflation
 
 

@@ -1,0 +1,306 @@
+"""Global planning on an occupancy grid: the global planner of move_base in the paper.
+
+:class:`Planner` gives geodesic distance fields (Dijkstra) and minimum-cost paths (A*)
+over the cells outside the inflated obstacles, on 8-connected moves without corner
+cutting (:mod:`pegame.navigation.search`), with a cost that keeps paths clear of walls
+like move_base's inflation decay. :meth:`Planner.shared` builds one planner per grid and
+parameters (:func:`pegame.grid.per_grid`) and hands the same read-only object to every
+caller (the game's spawn, both strategies); a planner's only mutable state is scratch
+memory of its searches, restored by every search before it returns, and the numba kernels
+hold the GIL, so two threads never use it at once.
+
+Units and frames: map-frame (x, y) in metres (:mod:`pegame.grid`); grid arrays are
+(height, width) indexed [row, col], row 0 the lowest y; distances and costs in metres.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from pegame.errors import require
+from pegame.grid import OccupancyGrid, per_grid, read_only
+from pegame.navigation.inflation import DISTANCE_TOLERANCE, shared_obstacle_distance
+from pegame.navigation.search import MOVES, allowed_moves, astar, dijkstra, pad_flat
+
+#: grids with at least this many cells get landmarks by default (see Planner)
+LARGE_GRID_CELLS = 1_000_000
+#: landmarks of a planner on a large grid by default
+LARGE_GRID_LANDMARKS = 12
+
+
+@dataclass(frozen=True, eq=False)
+class PathResult:
+    """A planned path.
+
+    path: float (K, 2) map-frame waypoints (m) from start to goal: cell centres, then the
+    exact goal point when its cell is traversable; empty when unreachable. length: the
+    polyline length of ``path`` (m). cost: the weighted grid cost of the cell path (m,
+    see :class:`Planner`); inf when unreachable. reachable: whether a path was found.
+    reason: '' when reachable, else why not.
+    """
+
+    path: np.ndarray
+    length: float
+    reachable: bool
+    reason: str = ""
+    cost: float = math.inf
+
+
+def _unreachable(reason: str) -> PathResult:
+    return PathResult(np.zeros((0, 2)), 0.0, False, reason)
+
+
+class Planner:
+    """Global planner on one map for one agent size.
+
+    grid: the occupancy map. radius: the agent's radius (m). margin (m): extra inflation
+    so planned paths stay executable by an agent whose collision mask is
+    ``inflate(grid, radius)``; a cell is traversable when it is outside
+    ``inflate(grid, radius + margin)``. clearance (m) and clearance_weight: a traversable
+    cell whose centre is d metres beyond the inflation zone (d = obstacle distance -
+    radius - margin) costs ``1 + clearance_weight * max(0, 1 - d / clearance)`` times its
+    length, so paths keep clear of walls when they can (no extra cost when clearance is
+    0). goal_snap (m): how far a goal in a non-traversable cell may be moved (see
+    :meth:`plan`). landmarks: how many landmark cost fields sharpen the A* heuristic (ALT,
+    see :meth:`_landmark_table`); 0 keeps the octile heuristic alone, and None (the
+    default) means LARGE_GRID_LANDMARKS on grids of at least LARGE_GRID_CELLS cells and 0
+    on smaller ones, such as the paper's maps. Landmarks cost one weighted distance field
+    each at the first plan and 8 bytes per cell each; on a large map a long search then
+    visits several times fewer cells. Paths stay optimal, but among equal-cost paths a
+    different one may be chosen than with the octile heuristic alone.
+    """
+
+    def __init__(
+        self,
+        grid: OccupancyGrid,
+        radius: float,
+        margin: float = 0.05,
+        clearance: float = 0.5,
+        clearance_weight: float = 2.0,
+        goal_snap: float = 1.0,
+        landmarks: int | None = None,
+    ) -> None:
+        for key, value in [
+            ("radius", radius),
+            ("margin", margin),
+            ("clearance", clearance),
+            ("clearance_weight", clearance_weight),
+            ("goal_snap", goal_snap),
+            ("landmarks", 0 if landmarks is None else landmarks),
+        ]:
+            # A non-negative clearance_weight also keeps every step at least as costly as
+            # its length, which the A* heuristic and the bucket queue rely on.
+            require(value >= 0, f"Planner.{key}", ">= 0", value)
+        self.grid = grid
+        self.radius = radius
+        self.goal_snap = goal_snap
+        inflation = radius + margin
+        distance = shared_obstacle_distance(grid)
+        self.traversable = read_only(distance > inflation + DISTANCE_TOLERANCE)
+        beyond = distance - inflation
+        if clearance > 0:
+            penalty = np.clip(1.0 - beyond / clearance, 0.0, 1.0)
+        else:
+            penalty = np.zeros_like(distance)
+        self.multipliers = read_only(1.0 + clearance_weight * penalty)
+        # Components under the planner's moves: without corner cutting these are the
+        # 4-connected components (labels 1.., 0 for non-traversable cells).
+        self._labels = read_only(ndimage.label(self.traversable)[0])
+        self._any_traversable = bool(self.traversable.any())
+        self._nearest: np.ndarray | None = None  # see _nearest_cells
+        self._padded_width = grid.width + 2
+        self._allowed = allowed_moves(pad_flat(self.traversable, False), self._padded_width, MOVES)
+        self._padded_multipliers = pad_flat(self.multipliers, 1.0)
+        # Search scratch memory, allocated at the first search that needs it.
+        self._astar_scratch: tuple[np.ndarray, ...] | None = None
+        self._bucket_pool: tuple[np.ndarray, np.ndarray] | None = None
+        if landmarks is None:
+            landmarks = LARGE_GRID_LANDMARKS if grid.data.size >= LARGE_GRID_CELLS else 0
+        self.landmarks = int(landmarks)
+        self._landmarks: np.ndarray | None = None  # see _landmark_table
+
+    @classmethod
+    def shared(cls, grid: OccupancyGrid, radius: float, **options) -> Planner:
+        """The planner for ``grid``, ``radius`` and ``options`` (the other constructor
+        arguments), built at the first call and returned again by every later call with
+        equal parameters for as long as the grid exists. Its arrays are read-only."""
+        arguments = inspect.signature(cls).bind(grid, radius, **options)
+        arguments.apply_defaults()  # so that omitted and explicit defaults share a planner
+        key = ("navigation", cls, *list(arguments.arguments.values())[1:])
+        return per_grid(grid, key, lambda grid: cls(grid, radius, **options))
+
+    def _flat(self, cell: tuple[int, int]) -> int:
+        """Index of (row, col) in the kernels' padded flat arrays."""
+        return (cell[0] + 1) * self._padded_width + cell[1] + 1
+
+    # -- cells
+
+    def _cell(self, xy) -> tuple[int, int]:
+        """The (row, col) containing map point xy (m), clamped into the grid."""
+        row, col = self.grid.world_to_cell(xy[0], xy[1])
+        return min(max(row, 0), self.grid.height - 1), min(max(col, 0), self.grid.width - 1)
+
+    def _is_traversable(self, xy) -> bool:
+        row, col = self.grid.world_to_cell(xy[0], xy[1])
+        return bool(self.grid.contains(row, col)) and bool(self.traversable[row, col])
+
+    def _source_cell(self, xy) -> tuple[int, int] | None:
+        """xy's cell if traversable, else the traversable cell whose centre is nearest to the
+        centre of xy's cell (clamped into the grid); None if no cell is traversable."""
+        if not self._any_traversable:
+            return None
+        row, col = self._cell(xy)
+        if self.traversable[row, col]:
+            return row, col
+        nearest = self._nearest_cells()
+        return int(nearest[0, row, col]), int(nearest[1, row, col])
+
+    def _nearest_cells(self) -> np.ndarray:
+        """Int (2, H, W): for every cell the (row, col) of the traversable cell whose centre
+        is nearest (itself when traversable). Computed at the first need: most queries start
+        in a traversable cell, and the transform costs about as much as the rest of init."""
+        if self._nearest is None:
+            _, nearest = ndimage.distance_transform_edt(~self.traversable, return_indices=True)
+            self._nearest = read_only(nearest)
+        return self._nearest
+
+    def nearest_traversable(self, xy) -> tuple[float, float] | None:
+        """Map-frame centre (m) of the traversable cell nearest to xy's cell (xy itself
+        when its cell is traversable, up to the cell centre); None if none is traversable."""
+        cell = self._source_cell(xy)
+        return None if cell is None else self.grid.cell_to_world(*cell)
+
+    def reachable(self, xy) -> np.ndarray:
+        """Bool (H, W): the traversable cells connected to xy's cell (or to the nearest
+        traversable cell when xy's cell is not traversable)."""
+        cell = self._source_cell(xy)
+        if cell is None:
+            return np.zeros(self.traversable.shape, dtype=bool)
+        return self._labels == self._labels[cell]
+
+    # -- searches
+
+    def distance_field(self, xy, weighted: bool = False) -> np.ndarray:
+        """Float64 (H, W): least path cost (m) from xy's cell to every cell over traversable
+        cells, np.inf where unreachable. Unweighted, this is the geodesic distance; weighted,
+        each step costs its length times the mean multiplier of its two cells. When xy's
+        cell is not traversable the search starts from the nearest traversable cell."""
+        cell = self._source_cell(xy)
+        if cell is None:
+            return np.full(self.traversable.shape, np.inf)
+        n = self._allowed.size
+        while True:
+            if self._bucket_pool is None:
+                # Cells usually enter the queue about once; start at 2 n + 1 entries and
+                # grow to the bound 8 n + 1 only if a search runs out.
+                self._bucket_pool = (np.empty(2 * n + 1, np.int32), np.empty(2 * n + 1, np.int32))
+            dist, complete = dijkstra(
+                self._allowed, self._padded_multipliers, weighted, self.grid.resolution,
+                self._padded_width, self._flat(cell), MOVES, *self._bucket_pool,
+            )
+            if complete:
+                return dist.reshape(self.grid.height + 2, self._padded_width)[1:-1, 1:-1]
+            self._bucket_pool = (np.empty(8 * n + 1, np.int32), np.empty(8 * n + 1, np.int32))
+
+    def _landmark_table(self) -> np.ndarray:
+        """Float (landmarks, n): weighted path costs (m) from each landmark cell to every flat
+        padded cell, 0 where unreachable. Built at the first need.
+
+        For a landmark L and cells v, goal, |cost(L, goal) - cost(L, v)| is a lower bound of
+        cost(v, goal) (triangle inequality; moves cost the same both ways), so A* may use the
+        largest of these bounds and the octile distance. Landmarks are placed by farthest
+        points in the largest connected region: each one is the cell farthest from those
+        chosen so far, the first the farthest from the region's first cell. Cells in other
+        regions get 0 bounds, which is admissible too. (Costs rounded to float32 would halve
+        the memory, but the rounding makes the heuristic slightly inconsistent, and A* then
+        re-expands so many cells that most of the gain is lost.)
+        """
+        if self._landmarks is None:
+            costs = np.zeros((self.landmarks, self._allowed.size))
+            if self.landmarks and self._any_traversable:
+                region = np.argmax(np.bincount(self._labels.ravel())[1:]) + 1
+                cell = np.unravel_index(np.argmax(self._labels == region), self._labels.shape)
+                nearest = self.distance_field(self.grid.cell_to_world(*cell), weighted=True)
+                for k in range(self.landmarks):
+                    farthest = np.argmax(np.where(np.isfinite(nearest), nearest, -1.0))
+                    cell = np.unravel_index(farthest, nearest.shape)
+                    field = self.distance_field(self.grid.cell_to_world(*cell), weighted=True)
+                    costs[k] = pad_flat(np.where(np.isfinite(field), field, 0.0), 0.0)
+                    nearest = field if k == 0 else np.minimum(nearest, field)
+            self._landmarks = read_only(costs)
+        return self._landmarks
+
+    def _search_scratch(self) -> tuple[np.ndarray, ...]:
+        """A*'s scratch arrays (g, parent, keys, ties, nodes, pos, touched), g all inf and
+        pos all -1 between searches."""
+        if self._astar_scratch is None:
+            n = self._allowed.size
+            self._astar_scratch = (
+                np.full(n, np.inf), np.empty(n, np.int32), np.empty(n), np.empty(n),
+                np.empty(n, np.int32), np.full(n, -1, np.int32), np.empty(n, np.int32),
+            )
+        return self._astar_scratch
+
+    def _snap_goal(self, goal_xy, label: int) -> tuple[int, int] | None:
+        """The cell with ``label`` whose centre is nearest to goal_xy and within goal_snap."""
+        res = self.grid.resolution
+        row, col = self.grid.world_to_cell(goal_xy[0], goal_xy[1])
+        k = int(math.ceil(self.goal_snap / res)) + 1
+        r0, r1 = max(row - k, 0), min(row + k + 1, self.grid.height)
+        c0, c1 = max(col - k, 0), min(col + k + 1, self.grid.width)
+        if r0 >= r1 or c0 >= c1:
+            return None
+        rows, cols = np.nonzero(self._labels[r0:r1, c0:c1] == label)
+        if rows.size == 0:
+            return None
+        rows, cols = rows + r0, cols + c0
+        x, y = self.grid.cell_to_world(rows, cols)
+        d = np.hypot(x - goal_xy[0], y - goal_xy[1])
+        best = int(np.argmin(d))
+        if d[best] > self.goal_snap + DISTANCE_TOLERANCE:
+            return None
+        return int(rows[best]), int(cols[best])
+
+    def plan(self, start_xy, goal_xy) -> PathResult:
+        """Minimum weighted cost path from start_xy to goal_xy (map frame, m); never raises.
+
+        A start outside the traversable cells (an agent touching the inflation zone) plans
+        from the nearest traversable cell. A goal whose cell is not traversable (near a wall,
+        inside an obstacle, off the map) is moved to the nearest cell reachable from the
+        start within goal_snap metres, and the path ends at that cell's centre; with none
+        there the result is unreachable. A goal in a traversable cell that the start cannot
+        reach is unreachable (it is never moved to the other side of a wall).
+        """
+        start = self._source_cell(start_xy)
+        if start is None:
+            return _unreachable("no traversable cell in the map")
+        label = self._labels[start]
+        exact_goal = self._is_traversable(goal_xy)
+        if exact_goal:
+            goal = self.grid.world_to_cell(goal_xy[0], goal_xy[1])
+            if self._labels[goal] != label:
+                return _unreachable("goal is not reachable from start")
+        else:
+            goal = self._snap_goal(goal_xy, label)
+            if goal is None:
+                row, col = self.grid.world_to_cell(goal_xy[0], goal_xy[1])
+                if not self.grid.contains(row, col):
+                    return _unreachable("goal is outside the map")
+                return _unreachable("goal is inside an obstacle")
+        cost, cells = astar(
+            self._allowed, self._padded_multipliers, self.grid.resolution, self._padded_width,
+            self._flat(start), self._flat(goal), MOVES, self._landmark_table(),
+            *self._search_scratch(),
+        )
+        rows, cols = np.divmod(cells, self._padded_width)
+        x, y = self.grid.cell_to_world(rows - 1, cols - 1)
+        path = np.column_stack([x, y])
+        if exact_goal:
+            path = np.vstack([path, np.asarray(goal_xy, dtype=float).reshape(1, 2)])
+        length = float(np.hypot(*np.diff(path, axis=0).T).sum())
+        return PathResult(path, length, True, "", float(cost))

@@ -1,0 +1,349 @@
+"""The grid search kernels of the planner: Dijkstra and A* on 8-connected moves.
+
+Grid moves: a path steps between the centres of 8-neighbouring traversable cells; a
+diagonal step is allowed only when both cells it passes between are traversable too,
+so the straight segment never touches a non-traversable cell (no corner cutting). As a
+consequence two cells are connected exactly when they are 4-connected. A step costs its
+length (m) times the mean of its two cells' multipliers (>= 1) when weighted.
+
+The kernels (numba) work on flat arrays of the grid padded with one ring of
+non-traversable cells, so a neighbour is a fixed index offset and needs no bounds check.
+Which of the 8 moves a cell allows (target traversable, no corner cutting) is precomputed
+as one bit per move (:func:`allowed_moves`), so a search reads one byte per cell instead
+of up to three traversable flags per move. :func:`dijkstra` is Dijkstra's algorithm with
+a bucket queue, :func:`astar` A* with an indexed binary heap; the plain-Python
+:func:`distance_field_reference` and :func:`astar_reference` (heapq on (row, col) cells)
+implement the same algorithms for the tests to compare against.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+from numba import njit
+
+SQRT2 = math.sqrt(2.0)
+
+#: the 8 moves as (row step, col step); orthogonal moves first
+MOVES = np.array(
+    [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)], dtype=np.int64
+)
+
+
+def pad_flat(array: np.ndarray, fill) -> np.ndarray:
+    """``array`` (H, W) padded with one ring of ``fill``, flattened to ((H+2) * (W+2),)."""
+    return np.pad(array, 1, constant_values=fill).ravel()
+
+
+@njit(cache=True)
+def _move_tables(padded_width, moves, resolution):
+    """Flat index offsets (cells) and lengths (m) of the 8 moves."""
+    offsets = moves[:, 0] * padded_width + moves[:, 1]
+    lengths = np.empty(8)
+    for k in range(8):
+        diagonal = moves[k, 0] != 0 and moves[k, 1] != 0
+        lengths[k] = resolution * SQRT2 if diagonal else resolution
+    return offsets, lengths
+
+
+@njit(cache=True)
+def allowed_moves(traversable, padded_width, moves):
+    """Uint8 per flat padded cell: bit k set when move k is allowed from the cell, i.e. the
+    cell and its target are traversable and, for a diagonal move, so are the two cells it
+    passes between."""
+    allowed = np.zeros(traversable.size, dtype=np.uint8)
+    offsets = moves[:, 0] * padded_width + moves[:, 1]
+    for u in range(padded_width, traversable.size - padded_width):
+        if not traversable[u]:
+            continue
+        for k in range(8):
+            if not traversable[u + offsets[k]]:
+                continue
+            if moves[k, 0] != 0 and moves[k, 1] != 0:
+                if not (traversable[u + moves[k, 0] * padded_width] and traversable[u + moves[k, 1]]):
+                    continue
+            allowed[u] |= 1 << k
+    return allowed
+
+
+@njit(cache=True)
+def dijkstra(allowed, multipliers, weighted, resolution, padded_width, source, moves, entry_cell,
+              entry_next):
+    """Least path cost (m) from flat cell ``source`` to every cell; inf if unreachable.
+
+    Dijkstra with a bucket queue (Dinitz's variant of Dial's algorithm): bucket b holds
+    cells with cost in [b w, (b+1) w) for a width w no larger than the cheapest move, so
+    no cell can improve another in its own bucket and every cell of the lowest bucket is
+    final. This gives the same costs as a binary heap at a fraction of the time. Buckets
+    are singly linked lists in the entry pool ``entry_cell``/``entry_next`` (scratch, int32)
+    kept on a ring; a cell whose cost drops is added again and its older entries are
+    skipped. Returns (costs, True), or (partial costs, False) when the pool was too small
+    (a cell enters it at most once per neighbour, so 8 n + 1 entries always suffice).
+    """
+    n = allowed.size
+    offsets, lengths = _move_tables(padded_width, moves, resolution)
+    max_step = resolution * SQRT2 * (multipliers.max() if weighted else 1.0)
+    # Slightly narrower than the cheapest move (resolution) so rounding cannot break the
+    # invariant; bucket indices are also forced past the current bucket.
+    width = resolution * (1.0 - 1e-9)
+    inverse_width = 1.0 / width
+    # A power-of-two ring turns the modulo into a mask (an integer division is slow).
+    ring = 1
+    while ring < int(max_step / width) + 3:
+        ring *= 2
+    wrap = ring - 1
+    dist = np.full(n, np.inf)
+    done = np.zeros(n, dtype=np.bool_)
+    head = np.full(ring, -1, dtype=np.int32)
+    dist[source] = 0.0
+    entry_cell[0], entry_next[0], head[0] = source, -1, 0
+    used, pending, bucket = 1, 1, 0
+    while pending > 0:
+        slot = bucket & wrap
+        while head[slot] != -1:
+            entry = head[slot]
+            head[slot] = entry_next[entry]
+            pending -= 1
+            u = entry_cell[entry]
+            if done[u]:
+                continue
+            done[u] = True
+            moves_u = allowed[u]
+            for k in range(8):
+                if not (moves_u >> k) & 1:
+                    continue
+                v = u + offsets[k]
+                if done[v]:
+                    continue
+                step = lengths[k]
+                if weighted:
+                    step = step * (0.5 * (multipliers[u] + multipliers[v]))
+                candidate = dist[u] + step
+                if candidate < dist[v]:
+                    if used == entry_cell.size:
+                        return dist, False
+                    dist[v] = candidate
+                    target = max(int(candidate * inverse_width), bucket + 1) & wrap
+                    entry_cell[used], entry_next[used] = v, head[target]
+                    head[target] = used
+                    used += 1
+                    pending += 1
+        bucket += 1
+    return dist, True
+
+
+@njit(cache=True)
+def _sift_up(keys, ties, nodes, pos, slot, node, key, tie):
+    """Place ``node`` with (key, tie) at heap ``slot`` or above.
+
+    The heap is an indexed binary min-heap with decrease-key: per slot a key, a tie-break
+    (smaller first) and a node; pos[node] is the node's slot, or -1 when not queued.
+    """
+    while slot > 0:
+        parent = (slot - 1) >> 1
+        if keys[parent] < key or (keys[parent] == key and ties[parent] <= tie):
+            break
+        keys[slot] = keys[parent]
+        ties[slot] = ties[parent]
+        nodes[slot] = nodes[parent]
+        pos[nodes[slot]] = slot
+        slot = parent
+    keys[slot] = key
+    ties[slot] = tie
+    nodes[slot] = node
+    pos[node] = slot
+
+
+@njit(cache=True)
+def _pop(keys, ties, nodes, pos, size):
+    """Remove and return the heap's minimum node; ``size`` is the size before removal."""
+    top = nodes[0]
+    pos[top] = -1
+    size -= 1
+    if size == 0:
+        return top
+    node, key, tie = nodes[size], keys[size], ties[size]
+    slot = 0
+    while True:
+        child = 2 * slot + 1
+        if child >= size:
+            break
+        right = child + 1
+        # Branch-free choice of the smaller child (a data-dependent branch mispredicts
+        # about every other time); keys beyond ``size`` are read but never chosen.
+        key_r, key_c = keys[right], keys[child]
+        child += (right < size) & ((key_r < key_c) | ((key_r == key_c) & (ties[right] < ties[child])))
+        if key < keys[child] or (key == keys[child] and tie <= ties[child]):
+            break
+        keys[slot] = keys[child]
+        ties[slot] = ties[child]
+        nodes[slot] = nodes[child]
+        pos[nodes[slot]] = slot
+        slot = child
+    keys[slot] = key
+    ties[slot] = tie
+    nodes[slot] = node
+    pos[node] = slot
+    return top
+
+
+@njit(cache=True)
+def _octile(resolution, row, col, goal_row, goal_col):
+    """Octile distance (m) between two cells: a lower bound of any path cost."""
+    dr = abs(row - goal_row)
+    dc = abs(col - goal_col)
+    return resolution * (max(dr, dc) + (SQRT2 - 1.0) * min(dr, dc))
+
+
+@njit(cache=True)
+def astar(allowed, multipliers, resolution, padded_width, start, goal, moves, landmark_costs, g,
+           parent, keys, ties, nodes, pos, touched):
+    """Minimum weighted cost (m) and flat cell path from ``start`` to ``goal`` by A*.
+
+    The heuristic is the octile distance, admissible and consistent because every
+    multiplier is >= 1, or the larger landmark bound when ``landmark_costs`` (K, n) has
+    rows (see ``Planner._landmark_table``). Returns (inf, empty) when the goal is
+    unreachable. The other arrays (length n) are scratch: ``g`` must be all inf and
+    ``pos`` all -1 on entry, and both are restored before returning (only the ``touched``
+    cells are reset, not the whole grid).
+    """
+    offsets, lengths = _move_tables(padded_width, moves, resolution)
+    goal_row, goal_col = goal // padded_width, goal % padded_width
+    to_goal = landmark_costs[:, goal].copy()
+    g[start] = 0.0
+    touched[0] = start
+    count = 1
+    parent[start] = -1
+    h = _octile(resolution, start // padded_width, start % padded_width, goal_row, goal_col)
+    h = _landmark_bound(landmark_costs, to_goal, start, h)
+    _sift_up(keys, ties, nodes, pos, 0, start, h, h)
+    size = 1
+    while size > 0:
+        u = _pop(keys, ties, nodes, pos, size)
+        size -= 1
+        if u == goal:
+            break
+        row, col = u // padded_width, u % padded_width
+        moves_u = allowed[u]
+        for k in range(8):
+            if not (moves_u >> k) & 1:
+                continue
+            v = u + offsets[k]
+            candidate = g[u] + lengths[k] * (0.5 * (multipliers[u] + multipliers[v]))
+            if candidate < g[v]:
+                if g[v] == np.inf:
+                    touched[count] = v
+                    count += 1
+                g[v] = candidate
+                parent[v] = u
+                h = _octile(resolution, row + moves[k, 0], col + moves[k, 1], goal_row, goal_col)
+                h = _landmark_bound(landmark_costs, to_goal, v, h)
+                # Among equal f prefer the smaller h (the deeper cell), so open areas are
+                # not flooded with ties.
+                slot = pos[v] if pos[v] >= 0 else size
+                if pos[v] < 0:
+                    size += 1
+                _sift_up(keys, ties, nodes, pos, slot, v, candidate + h, h)
+    cost = g[goal]
+    path = _trace(parent, start, goal) if np.isfinite(cost) else np.empty(0, dtype=np.int64)
+    for i in range(count):
+        g[touched[i]] = np.inf
+        pos[touched[i]] = -1
+    return cost, path
+
+
+@njit(cache=True)
+def _landmark_bound(landmark_costs, to_goal, v, h):
+    """The largest of ``h`` and the landmark bounds |cost(L, goal) - cost(L, v)| (m)."""
+    for k in range(to_goal.size):
+        h = max(h, abs(to_goal[k] - landmark_costs[k, v]))
+    return h
+
+
+@njit(cache=True)
+def _trace(parent, start, goal):
+    """The flat cells from ``start`` to ``goal`` along the ``parent`` links."""
+    count = 1
+    node = goal
+    while node != start:
+        node = parent[node]
+        count += 1
+    path = np.empty(count, dtype=np.int64)
+    node = goal
+    for i in range(count - 1, -1, -1):
+        path[i] = node
+        node = parent[node]
+    return path
+
+
+# -------------------------------------------------------------- plain-Python references
+
+
+def _reference_neighbours(traversable, multipliers, weighted, resolution, cell):
+    """Yield (neighbour cell, step cost m) for the allowed moves from ``cell``."""
+    height, width = traversable.shape
+    r, c = cell
+    for dr, dc in MOVES.tolist():
+        nr, nc = r + dr, c + dc
+        if not (0 <= nr < height and 0 <= nc < width and traversable[nr, nc]):
+            continue
+        step = resolution
+        if dr and dc:
+            if not (traversable[r, nc] and traversable[nr, c]):
+                continue
+            step = resolution * SQRT2
+        if weighted:
+            step = step * (0.5 * (multipliers[r, c] + multipliers[nr, nc]))
+        yield (nr, nc), step
+
+
+def distance_field_reference(traversable, multipliers, weighted, resolution, source):
+    """Plain-Python Dijkstra with heapq; same contract as :func:`dijkstra` but takes and
+    returns (row, col) cells: float64 (H, W) costs (m) from ``source``, inf if unreachable."""
+    dist = np.full(traversable.shape, np.inf)
+    dist[source] = 0.0
+    queue = [(0.0, source)]
+    while queue:
+        d, cell = heapq.heappop(queue)
+        if d > dist[cell]:
+            continue
+        moves = _reference_neighbours(traversable, multipliers, weighted, resolution, cell)
+        for nxt, step in moves:
+            if d + step < dist[nxt]:
+                dist[nxt] = d + step
+                heapq.heappush(queue, (d + step, nxt))
+    return dist
+
+
+def astar_reference(traversable, multipliers, resolution, start, goal):
+    """Plain-Python A* with heapq and the octile heuristic on the weighted grid.
+
+    Returns (cost m, list of (row, col) cells from start to goal), or (inf, []).
+    """
+
+    def heuristic(cell):
+        dr, dc = abs(cell[0] - goal[0]), abs(cell[1] - goal[1])
+        return resolution * (max(dr, dc) + (SQRT2 - 1.0) * min(dr, dc))
+
+    g = {start: 0.0}
+    parent = {start: None}
+    queue = [(heuristic(start), start)]
+    while queue:
+        f, cell = heapq.heappop(queue)
+        if cell == goal:
+            break
+        if f > g[cell] + heuristic(cell):
+            continue
+        for nxt, step in _reference_neighbours(traversable, multipliers, True, resolution, cell):
+            if g[cell] + step < g.get(nxt, math.inf):
+                g[nxt] = g[cell] + step
+                parent[nxt] = cell
+                heapq.heappush(queue, (g[nxt] + heuristic(nxt), nxt))
+    if goal not in g:
+        return math.inf, []
+    path = [goal]
+    while parent[path[-1]] is not None:
+        path.append(parent[path[-1]])
+    return g[goal], path[::-1]
