@@ -193,11 +193,11 @@ def test_holm_adjusts_in_input_order():
 def test_h1_holds_when_smart_pursuer_is_better_and_fails_otherwise(tmp_path):
     cells = separated("S-R", "R-R")
     cells[("enclosed", 1.0, "S-R")] = [0.7, 0.8]  # no R-R here: not tested
-    h1 = report.hypotheses(report.rates_by_cell(sweep_games(cells)))[0]
+    h1 = report.hypotheses(cells)[0]
     assert h1["summary"] == {"verdict": "holds", "k": 4, "n": 4, "untested": 1,
                              "text": "holds (in 4 of 4 cells)"}
     assert all(row["p_holm"] <= report.ALPHA for row in h1["rows"] if row["p"] is not None)
-    h1 = report.hypotheses(report.rates_by_cell(sweep_games(separated("R-R", "S-R"))))[0]
+    h1 = report.hypotheses(separated("R-R", "S-R"))[0]
     assert h1["summary"]["verdict"] == "fails" and h1["summary"]["k"] == 0
 
     write_job(tmp_path, "0", sweep_games(cells))
@@ -209,12 +209,12 @@ def test_h1_holds_when_smart_pursuer_is_better_and_fails_otherwise(tmp_path):
 
 
 def test_h2_tests_the_slow_ratio_and_shows_the_rate_at_equal_speed():
-    h2 = report.hypotheses(report.rates_by_cell(sweep_games(separated("S-R", "R-R"))))[1]
+    h2 = report.hypotheses(separated("S-R", "R-R"))[1]
     assert [(row["map"], row["speed_ratio"]) for row in h2["rows"]] == [("hall", 0.5), ("brick", 0.5)]
     assert h2["summary"]["verdict"] == "holds"
     assert h2["rows"][0]["x_stats_at_1"]["n"] == 12
     only_equal = {("hall", 1.0, "S-R"): [0.8], ("hall", 1.0, "R-R"): [0.2]}
-    h2 = report.hypotheses(report.rates_by_cell(sweep_games(only_equal)))[1]
+    h2 = report.hypotheses(only_equal)[1]
     assert h2["rows"][0]["speed_ratio"] == 0.5 and h2["summary"]["text"] == report.UNTESTED
 
 
@@ -224,7 +224,7 @@ def test_h3_needs_smart_evader_tracked_less_but_above_45_percent():
              ("hall", 1.0, "S-S"): rng.uniform(0.5, 0.7, 15).tolist(),
              ("brick", 1.0, "S-R"): rng.uniform(0.8, 0.95, 15).tolist(),
              ("brick", 1.0, "S-S"): rng.uniform(0.1, 0.3, 15).tolist()}
-    h3 = report.hypotheses(report.rates_by_cell(sweep_games(cells)))[2]
+    h3 = report.hypotheses(cells)[2]
     by_map = {row["map"]: row for row in h3["rows"]}
     assert by_map["hall"]["holds"] and by_map["hall"]["tracked_less"]
     assert by_map["brick"]["tracked_less"] and not by_map["brick"]["reasonable"]
