@@ -10,6 +10,7 @@ import sys
 
 import numpy as np
 import pytest
+import yaml
 
 from pegame import report
 from report_fixtures import PROVENANCE, config_game, config_job, game, table_rows, write_job
@@ -185,3 +186,17 @@ def test_legacy_lines_load_beside_lines_with_config(tmp_path):
     assert {"pegame": "0.3.0", "commit": PROVENANCE["commit"], "dirty": False} in versions
     assert None in versions  # the old lines carry no provenance
     assert "| – | 1 |" in (tmp_path / "table1.md").read_text()
+
+
+def test_old_lines_take_the_config_their_job_kept_in_hydra(tmp_path):
+    """Lines written before they carried ``config`` are told apart by .hydra/config.yaml."""
+    for name, miss in (("0", 0.0), ("1", 0.3)):
+        job = write_job(tmp_path, name, [game("enclosed", 1.0, "S-R", s, 0.9 - miss) for s in range(5)])
+        config = {"game": {"seed": 0, "trials": 5, "t_max": 90.0, "speed_ratio": 1.0},
+                  "env": {"name": "enclosed"}, "detector": {"name": "oracle", "miss_probability": miss},
+                  "resume": name == "1"}  # seed, trials and resume are no part of the configuration
+        (job / ".hydra" / "config.yaml").write_text(yaml.safe_dump(config))
+    result = report.write_report(tmp_path)
+    assert result["factors"] == ["detector.miss_probability"]
+    assert [(c["factors"]["detector.miss_probability"], c["n"]) for c in result["cells"]] == [
+        (0.0, 5), (0.3, 5)]

@@ -57,16 +57,18 @@ def canonical(value: Any) -> str:
 
 def settings(record: dict[str, Any]) -> dict[str, Any]:
     """The game's settings as {dotted key: value}."""
-    if "config" in record:
+    if record.get("config") is not None:
         return flatten(record["config"])
     return {key: record[field_] for field_, key in LEGACY.items() if record.get(field_) is not None}
 
 
 def identity(record: dict[str, Any]) -> str:
-    """The configuration's hash: the line's ``config_hash``, else the sha256 of its settings."""
+    """The configuration's hash: the line's ``config_hash``, else the sha256 of the canonical
+    JSON of its ``config`` (of its :data:`LEGACY` settings for old lines)."""
     if record.get("config_hash"):
         return record["config_hash"]
-    return hashlib.sha256(canonical(settings(record)).encode()).hexdigest()
+    config = record["config"] if record.get("config") is not None else settings(record)
+    return hashlib.sha256(canonical(config).encode()).hexdigest()
 
 
 def code_version(record: dict[str, Any]) -> dict[str, Any] | None:
@@ -133,7 +135,7 @@ def select(records: list[dict[str, Any]]) -> Selection:
                 dropped.setdefault(key, []).append(games[key][1])
             games[key] = (index, record)
         else:
-            failures[failure_key(record, "config" not in record)] = (index, record)
+            failures[failure_key(record, record.get("config") is None)] = (index, record)
     finished: dict[tuple, int] = {}
     for index, record in games.values():
         for legacy in (False, True):

@@ -6,7 +6,8 @@ type by type, so that later stages can trust it: a line that is cut (a job kille
 mid-write), of an unknown kind, without a required key or with a value of the wrong type
 is skipped and listed with its reason, never a traceback. Every record kept is tagged
 with its ``job`` (a POSIX path relative to its sweep directory, prefixed with that
-directory when several are read) and its ``line`` number.
+directory when several are read) and its ``line`` number; an old line without ``config``
+of a job that kept its ``.hydra/config.yaml`` gets that config.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from pegame.errors import PegameError
 log = logging.getLogger("pegame.report")
 
 RESULTS = "results.jsonl"
+NOT_CONFIG = (("game", "seed"), ("game", "trials"), ("resume",), ("hydra",))  # vary per job, not per configuration
 
 
 class ReportError(PegameError, OSError):
@@ -121,6 +123,26 @@ def read_overrides(job: Path) -> list[str] | None:
     return [str(o) for o in overrides] if isinstance(overrides, list) else None
 
 
+def job_config(job: Path) -> dict[str, Any] | None:
+    """The job's resolved config from ``.hydra/config.yaml`` without the keys of
+    :data:`NOT_CONFIG`; None when absent or unreadable. For old lines, which carry no
+    ``config`` of their own."""
+    path = job / ".hydra" / "config.yaml"
+    try:
+        config = yaml.safe_load(path.read_text()) if path.is_file() else None
+    except (OSError, yaml.YAMLError):
+        return None
+    if not isinstance(config, dict):
+        return None
+    for *parents, leaf in NOT_CONFIG:
+        node = config
+        for parent in parents:
+            node = node.get(parent) if isinstance(node, dict) else None
+        if isinstance(node, dict):
+            node.pop(leaf, None)
+    return config
+
+
 def problem(record: Any) -> str | None:
     """Why a decoded line is unusable, or None when it is a valid record."""
     if not isinstance(record, dict) or record.get("kind") not in REQUIRED:
@@ -192,6 +214,10 @@ def read_job(sweep: Sweep, job: Path, name: str, file_name: str) -> None:
         return
     records, skipped = read_jsonl(path, file_name)
     sweep.skipped += skipped
+    old = [r for r in records if r["kind"] in ("game", "failed") and r.get("config") is None]
+    config = job_config(job) if old else None
+    for record in old if config is not None else []:
+        record["config"] = config
     tagged = [{**record, "job": name} for record in records]
     sweep.records += [r for r in tagged if r["kind"] in ("game", "failed")]
     sweep.invalid += [r for r in tagged if r["kind"] == "invalid"]
