@@ -148,6 +148,7 @@ def select(records: list[dict[str, Any]]) -> Selection:
 
 
 def axis_value(record: dict[str, Any], axis: str) -> Any:
+    """The record's value on one paper axis (map, speed_ratio or pairing)."""
     return float(record["speed_ratio"]) if axis == "speed_ratio" else record[axis]
 
 
@@ -191,6 +192,7 @@ class Cell:
 
     @property
     def rates(self) -> list[float]:
+        """The tracking rates of its games, fractions in [0, 1]."""
         return [float(g["tracking_rate"]) for g in self.games]
 
     @property
@@ -199,9 +201,11 @@ class Cell:
         return tuple(hashable(v) for v in self.factors.values())
 
     def config_hashes(self) -> list[str]:
+        """The distinct config hashes of its games, sorted."""
         return sorted({identity(g) for g in self.games})
 
     def code_versions(self) -> list[dict[str, Any] | None]:
+        """The distinct code versions of its games (None: a line without provenance)."""
         versions = {canonical(code_version(g)): code_version(g) for g in self.games}
         return [versions[k] for k in sorted(versions)]
 

@@ -49,9 +49,9 @@ def box_figure(panels: list[tuple[str, dict[str, list[list[float]]]]], groups: l
     width = max(6.0, 0.8 * len(groups) * max(1, len(pairings)) + 2)
     fig = Figure(figsize=(width * columns, 4.5 * rows), layout="constrained")
     axes = fig.subplots(rows, columns, squeeze=False, sharey=True).ravel()
-    for ax, (panel, series) in zip(axes, panels):
+    for index, (ax, (panel, series)) in enumerate(zip(axes, panels)):
         draw_boxes(ax, groups, series)
-        ax.set(xlabel=xlabel, ylabel=RATE_LABEL, title=panel)
+        ax.set(xlabel=xlabel, ylabel=RATE_LABEL if index % columns == 0 else "", title=panel)
     for ax in axes[len(panels):]:
         ax.set_visible(False)
     fig.suptitle(title)

@@ -50,14 +50,17 @@ def is_int(value: Any) -> bool:
 
 
 def is_str(value: Any) -> bool:
+    """A string."""
     return isinstance(value, str)
 
 
 def is_str_list(value: Any) -> bool:
+    """A list of strings."""
     return isinstance(value, list) and all(isinstance(v, str) for v in value)
 
 
 def is_dict(value: Any) -> bool:
+    """A JSON object."""
     return isinstance(value, dict)
 
 

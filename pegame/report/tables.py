@@ -51,6 +51,7 @@ class Layout:
         return [self.lookup.get((*row, m, p)) for m in self.maps for p in self.pairings]
 
     def factor_texts(self, row: tuple) -> list[str]:
+        """The other factors' values of one row, as text."""
         return [value_text(v) for v in self.row_factors[row].values()]
 
 
