@@ -128,6 +128,9 @@ def test_several_sweep_dirs_are_compared_as_one_study(tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert "8 games" in proc.stdout and "H1 (estimator.name=last_seen)" in proc.stdout
+    proc = subprocess.run([sys.executable, "-m", "pegame.report", str(tmp_path / "a"),
+                           str(tmp_path / "b")], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "several sweep directories need --out" in proc.stderr
 
 
 def test_failed_games_are_listed_unless_a_later_run_finished_them(tmp_path):
