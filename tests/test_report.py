@@ -1,63 +1,21 @@
-"""Sweep aggregation on synthetic multirun directories with known answers."""
+"""The sweep report end to end on synthetic multirun directories with known answers: the
+statistics, the table layout, what is missing, failed or unreadable, figures, the CLI."""
 
 from __future__ import annotations
 
 import csv
+import errno
 import json
 import logging
 import math
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from pegame import report
-
-STRATEGY = {"R": "random", "S": "smart"}
-
-
-def game(map_name: str, ratio: float, pairing: str, seed: int, rate: float) -> dict:
-    """A finished-game record as pegame writes it (only the fields the report reads, and some)."""
-    pursuer, evader = (STRATEGY.get(letter, letter.lower()) for letter in pairing.split("-"))
-    return {"kind": "game", "pairing": pairing, "pursuer": pursuer, "evader": evader,
-            "estimator": "last_seen", "detector": "oracle", "sim": "grid", "map": map_name,
-            "seed": seed, "speed_ratio": ratio, "t_max": 90.0, "tracking_rate": rate,
-            "visible_rate": rate}
-
-
-def write_job(root: Path, name: str, records: list[dict], overrides: list[str] | None = None,
-              tail: str = "", summary: bool = True) -> Path:
-    """A job dir with .hydra/overrides.yaml and results.jsonl (``records``, a summary line
-    unless ``summary`` is False, then ``tail`` verbatim)."""
-    job = root / name
-    (job / ".hydra").mkdir(parents=True)
-    (job / ".hydra" / "overrides.yaml").write_text("".join(f"- {o}\n" for o in overrides or []))
-    ok = [r for r in records if r["kind"] == "game"]
-    if summary:
-        records = records + [{"kind": "summary", "games": len(ok), "failed": len(records) - len(ok),
-                              "tracking_rate_mean": None}]
-    lines = "".join(json.dumps(r) + "\n" for r in records)
-    (job / "results.jsonl").write_text(lines + tail)
-    return job
-
-
-def sweep_games(rates: dict[tuple[str, float, str], list[float]]) -> list[dict]:
-    """Game records for {(map, ratio, pairing): rates}, seeds 0.. within each cell."""
-    return [game(m, r, p, seed, v) for (m, r, p), values in rates.items()
-            for seed, v in enumerate(values)]
-
-
-def separated(high: str, low: str, n: int = 12) -> dict:
-    """Rates where pairing ``high`` clearly beats ``low`` in 2 maps x 2 speed ratios."""
-    rng = np.random.default_rng(1)
-    cells = {}
-    for m in ("hall", "brick"):
-        for r in (0.5, 1.0):
-            cells[(m, r, high)] = rng.uniform(0.6, 0.9, n).tolist()
-            cells[(m, r, low)] = rng.uniform(0.1, 0.4, n).tolist()
-    return cells
+from report_fixtures import config_game, config_job, game, separated, sweep_games, write_job
 
 
 def test_mean_is_the_sample_mean_and_ci_contains_the_population_mean(tmp_path):
@@ -161,77 +119,6 @@ def test_an_empty_directory_gives_an_empty_report(tmp_path):
     assert (tmp_path / "fig8_pairing.png").stat().st_size > 0
 
 
-def test_failed_games_are_listed_unless_a_later_run_finished_them(tmp_path):
-    failed = [{"kind": "failed", "seed": s, "pairing": "S-S", "map": "brick", "speed_ratio": 2.0,
-               "error": f"SpawnError: no valid spawn {s}", "traceback_file": f"failed_{s}.txt"}
-              for s in (4, 5)]
-    write_job(tmp_path, "0", [game("brick", 2.0, "S-S", 3, 0.4), *failed])
-    write_job(tmp_path, "1", [game("brick", 2.0, "S-S", 5, 0.6)])
-    result = report.write_report(tmp_path)
-    assert [(f["seed"], f["job"]) for f in result["failed_games"]] == [(4, "0")]
-    md = (tmp_path / "table1.md").read_text()
-    assert "SpawnError: no valid spawn 4 (traceback: 0/failed_4.txt)" in md
-    assert "no valid spawn 5" not in md
-    assert result["cells"][0]["n"] == 2
-
-
-def test_duplicate_games_count_once_and_the_later_line_wins(tmp_path):
-    write_job(tmp_path, "0", [game("hall", 1.0, "R-R", 0, 0.1), game("hall", 1.0, "R-R", 1, 0.2),
-                              game("hall", 1.0, "R-R", 0, 0.3)])
-    write_job(tmp_path, "10", [game("hall", 1.0, "R-R", 1, 0.5)])
-    write_job(tmp_path, "2", [game("hall", 1.0, "R-R", 1, 0.4)])
-    (row,) = report.write_report(tmp_path)["cells"]
-    assert row["n"] == 2 and row["mean"] == pytest.approx((0.3 + 0.5) / 2)
-
-
-def test_holm_adjusts_in_input_order():
-    assert report.holm([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
-    assert report.holm([0.5, 0.001]) == pytest.approx([0.5, 0.002])
-    assert report.holm([]) == []
-
-
-def test_h1_holds_when_smart_pursuer_is_better_and_fails_otherwise(tmp_path):
-    cells = separated("S-R", "R-R")
-    cells[("enclosed", 1.0, "S-R")] = [0.7, 0.8]  # no R-R here: not tested
-    h1 = report.hypotheses(report.rates_by_cell(sweep_games(cells)))[0]
-    assert h1["summary"] == {"verdict": "holds", "k": 4, "n": 4, "untested": 1,
-                             "text": "holds (in 4 of 4 cells)"}
-    assert all(row["p_holm"] <= report.ALPHA for row in h1["rows"] if row["p"] is not None)
-    h1 = report.hypotheses(report.rates_by_cell(sweep_games(separated("R-R", "S-R"))))[0]
-    assert h1["summary"]["verdict"] == "fails" and h1["summary"]["k"] == 0
-
-    write_job(tmp_path, "0", sweep_games(cells))
-    result = report.write_report(tmp_path, tmp_path / "hyp")
-    md = (tmp_path / "hyp" / "hypotheses.md").read_text()
-    assert "## H1: holds (in 4 of 4 cells)" in md
-    assert "| enclosed | 1 | 75.0% [70.0, 80.0] n=2 | – |" in md and report.UNTESTED in md
-    assert result["hypotheses"][0]["summary"]["k"] == 4
-
-
-def test_h2_tests_the_slow_ratio_and_shows_the_rate_at_equal_speed():
-    h2 = report.hypotheses(report.rates_by_cell(sweep_games(separated("S-R", "R-R"))))[1]
-    assert [(row["map"], row["speed_ratio"]) for row in h2["rows"]] == [("hall", 0.5), ("brick", 0.5)]
-    assert h2["summary"]["verdict"] == "holds"
-    assert h2["rows"][0]["x_stats_at_1"]["n"] == 12
-    only_equal = {("hall", 1.0, "S-R"): [0.8], ("hall", 1.0, "R-R"): [0.2]}
-    h2 = report.hypotheses(report.rates_by_cell(sweep_games(only_equal)))[1]
-    assert h2["rows"][0]["speed_ratio"] == 0.5 and h2["summary"]["text"] == report.UNTESTED
-
-
-def test_h3_needs_smart_evader_tracked_less_but_above_45_percent():
-    rng = np.random.default_rng(2)
-    cells = {("hall", 1.0, "S-R"): rng.uniform(0.8, 0.95, 15).tolist(),
-             ("hall", 1.0, "S-S"): rng.uniform(0.5, 0.7, 15).tolist(),
-             ("brick", 1.0, "S-R"): rng.uniform(0.8, 0.95, 15).tolist(),
-             ("brick", 1.0, "S-S"): rng.uniform(0.1, 0.3, 15).tolist()}
-    h3 = report.hypotheses(report.rates_by_cell(sweep_games(cells)))[2]
-    by_map = {row["map"]: row for row in h3["rows"]}
-    assert by_map["hall"]["holds"] and by_map["hall"]["tracked_less"]
-    assert by_map["brick"]["tracked_less"] and not by_map["brick"]["reasonable"]
-    assert h3["summary"]["text"] == "partly (in 1 of 2 cells)"
-    assert h3["reasonable_cells"] == {"k": 1, "n": 2}
-
-
 def test_figures_are_non_empty_png_and_svg(tmp_path):
     write_job(tmp_path, "0", sweep_games(separated("S-R", "R-R", n=5)))
     result = report.write_report(tmp_path)
@@ -256,3 +143,57 @@ def test_cli_writes_the_report_into_out(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "pegame.report", str(tmp_path / "nowhere")],
                          capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and "not a directory" in bad.stderr
+
+
+@pytest.mark.parametrize("field, value", [
+    ("seed", "seven"), ("tracking_rate", "high"), ("tracking_rate", 1.5), ("speed_ratio", True),
+    ("config", [1, 2]), ("config_hash", 7), ("overrides", "env=hall"), ("provenance", "0.3"),
+    ("map", 3),
+])
+def test_a_line_with_a_wrong_type_is_skipped_and_listed(tmp_path, field, value):
+    bad = {**config_game(9, 0.5), field: value}
+    write_job(tmp_path, "0", [config_game(0, 0.5), bad, config_game(1, 0.7)])
+    result = report.write_report(tmp_path)
+    assert result["games"] == 2 and result["cells"][0]["n"] == 2
+    (skipped,) = result["skipped_lines"]
+    assert skipped["line"] == 2 and f"'{field}' is {value!r}" in skipped["reason"]
+    assert "0/results.jsonl line 2: game record with a wrong type" in (tmp_path / "table1.md").read_text()
+
+
+def test_invalid_cells_are_listed_and_the_others_reported(tmp_path):
+    config_job(tmp_path, "0", range(3), [0.5, 0.6, 0.7])
+    job = tmp_path / "1"
+    (job / ".hydra").mkdir(parents=True)
+    error = "Invalid value for 'detector.miss_probability': 1.5. Allowed: a number in [0, 1)."
+    (job / "results.jsonl").write_text(json.dumps({
+        "kind": "invalid", "error": error, "overrides": ["detector.miss_probability=1.5"]}) + "\n")
+    result = report.write_report(tmp_path)
+    assert result["games"] == 3 and [c["n"] for c in result["cells"]] == [3]
+    (failed,) = result["failed_cells"]
+    assert failed["job"] == "1" and failed["error"] == error
+    assert result["unfinished_jobs"] == [] and result["missing_jobs"] == []
+    md = (tmp_path / "table1.md").read_text()
+    assert "### Failed cells (invalid configuration): 1" in md
+    assert f"- job 1: overrides detector.miss_probability=1.5: {error}" in md
+
+
+def test_a_report_that_cannot_be_written_is_one_clear_error(tmp_path, monkeypatch):
+    config_job(tmp_path / "sweep", "0", range(2), [0.5, 0.6])
+    (tmp_path / "file").write_text("not a directory")
+    with pytest.raises(report.ReportError, match="Cannot write the report into"):
+        report.write_report(tmp_path / "sweep", tmp_path / "file" / "out")
+    proc = subprocess.run([sys.executable, "-m", "pegame.report", str(tmp_path / "sweep"),
+                           "--out", str(tmp_path / "file" / "out")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "error: Cannot write the report into" in proc.stderr
+    assert "Traceback" not in proc.stderr
+
+    def full_disk(path, data):
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr("pegame.report.write_atomic", full_disk)
+    with pytest.raises(report.ReportError, match="No space left on device"):
+        report.write_report(tmp_path / "sweep")
+    assert report.main([str(tmp_path / "sweep")]) == 2
+    with pytest.raises(report.ReportError, match="No such sweep directory"):
+        report.write_report(tmp_path / "nowhere")
