@@ -59,10 +59,23 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from pegame.grid import OccupancyGrid
 
 __all__ = [
-    "BLOCK", "WALL_X", "ConformanceError", "DetectorConformance", "EstimatorConformance",
-    "EvaderConformance", "PluginConformance", "PursuerConformance", "RecorderConformance",
-    "SimulatorConformance", "check_config_errors", "check_config_file", "check_interface",
-    "check_plugin", "check_same_seed_same_game", "missing_dependency_error", "small_context",
+    "BLOCK",
+    "WALL_X",
+    "ConformanceError",
+    "DetectorConformance",
+    "EstimatorConformance",
+    "EvaderConformance",
+    "PluginConformance",
+    "PursuerConformance",
+    "RecorderConformance",
+    "SimulatorConformance",
+    "check_config_errors",
+    "check_config_file",
+    "check_interface",
+    "check_plugin",
+    "check_same_seed_same_game",
+    "missing_dependency_error",
+    "small_context",
     "small_map",
 ]
 
@@ -77,11 +90,13 @@ def _fail_unless(ok: bool, message: str) -> None:
 
 
 def _interface(kind: str) -> type[Plugin]:
-    _fail_unless(kind in INTERFACES, f"Unknown plugin kind '{kind}'. Kinds: {', '.join(INTERFACES)}.")
+    _fail_unless(
+        kind in INTERFACES, f"Unknown plugin kind '{kind}'. Kinds: {', '.join(INTERFACES)}."
+    )
     return INTERFACES[kind]
 
 
-def registered_name(kind: str, cls: type) -> str | None:
+def registered_name(kind: str, cls: type[Plugin]) -> str | None:
     """The entry-point name under which ``cls`` is registered for ``kind``, without
     importing any plugin; None when it is not registered."""
     target = f"{cls.__module__}:{cls.__qualname__}"
@@ -94,7 +109,7 @@ def registered_name(kind: str, cls: type) -> str | None:
 # ------------------------------------------------------------------------ the checks
 
 
-def check_interface(kind: str, cls: type, name: str | None = None) -> None:
+def check_interface(kind: str, cls: type[Plugin], name: str | None = None) -> None:
     """Rule 1: ``cls`` implements the ``kind`` interface and is what the registry loads for
     ``name`` (default: the name it is registered under)."""
     interface = _interface(kind)
@@ -103,17 +118,23 @@ def check_interface(kind: str, cls: type, name: str | None = None) -> None:
         f"{cls!r} must subclass pegame.api.{interface.__name__} to be a {kind} plugin.",
     )
     missing = sorted(getattr(cls, "__abstractmethods__", ()))
-    _fail_unless(not missing, f"{cls.__name__} does not implement {', '.join(missing)} of "
-                 f"{interface.__name__}.")
+    _fail_unless(
+        not missing,
+        f"{cls.__name__} does not implement {', '.join(missing)} of {interface.__name__}.",
+    )
     description = cls.description
     _fail_unless(
-        isinstance(description, str) and description.strip() != "" and "\n" not in description.strip(),
-        f"{cls.__name__}.description must be a one-line summary (python -m pegame.plugins shows it), "
-        f"got {description!r}.",
+        isinstance(description, str)
+        and description.strip() != ""
+        and "\n" not in description.strip(),
+        f"{cls.__name__}.description must be a one-line summary (python -m pegame.plugins "
+        f"shows it), got {description!r}.",
     )
     config = cls.Config
-    _fail_unless(dataclasses.is_dataclass(config) and isinstance(config, type),
-                 f"{cls.__name__}.Config must be a dataclass of the plugin's parameters.")
+    _fail_unless(
+        dataclasses.is_dataclass(config) and isinstance(config, type),
+        f"{cls.__name__}.Config must be a dataclass of the plugin's parameters.",
+    )
     required = [f.name for f in dataclasses.fields(interface.Config)]
     _fail_unless(
         not required or issubclass(config, interface.Config),
@@ -130,15 +151,21 @@ def check_interface(kind: str, cls: type, name: str | None = None) -> None:
     _fail_unless(loaded is cls, f"registry.load('{kind}', '{name}') gives {loaded!r}, not {cls!r}.")
 
 
-def check_config_errors(kind: str, cls: type, bad_values: Mapping[str, Any] | None = None) -> None:
+def check_config_errors(
+    kind: str, cls: type[Plugin], bad_values: Mapping[str, Any] | None = None
+) -> None:
     """Rule 2, the dataclass: defaults construct; an unknown key, a non-number for each
     numeric field and each ``bad_values`` item raise ConfigError naming ``kind.key``."""
     try:
         defaults = cls.Config()
-    except Exception as exc:  # noqa: BLE001 - any failure is the finding
-        raise ConformanceError(f"{cls.__name__}.Config() must construct from its defaults: {exc}") from exc
-    _fail_unless(registry.make_config(kind, cls, {}) == defaults,
-                 f"registry.make_config('{kind}', {cls.__name__}, {{}}) must equal {cls.__name__}.Config().")
+    except Exception as exc:
+        raise ConformanceError(
+            f"{cls.__name__}.Config() must construct from its defaults: {exc}"
+        ) from exc
+    _fail_unless(
+        registry.make_config(kind, cls, {}) == defaults,
+        f"registry.make_config('{kind}', {cls.__name__}, {{}}) must equal {cls.__name__}.Config().",
+    )
     cases: dict[str, Any] = {"no_such_key": 1}
     for field in dataclasses.fields(defaults):
         value = getattr(defaults, field.name)
@@ -148,35 +175,55 @@ def check_config_errors(kind: str, cls: type, bad_values: Mapping[str, Any] | No
         try:
             registry.make_config(kind, cls, {key: value})
         except ConfigError as exc:
-            _fail_unless(f"{kind}.{key}" in str(exc),
-                         f"The ConfigError for {kind}.{key}={value!r} must name '{kind}.{key}': {exc}")
-        except Exception as exc:  # noqa: BLE001 - any other exception is the finding
+            _fail_unless(
+                f"{kind}.{key}" in str(exc),
+                f"The ConfigError for {kind}.{key}={value!r} must name '{kind}.{key}': {exc}",
+            )
+        except Exception as exc:
             raise ConformanceError(
                 f"{kind}.{key}={value!r} must raise pegame.errors.ConfigError (call "
                 f"pegame.errors.require in Config.__post_init__), not {type(exc).__name__}: {exc}"
             ) from exc
         else:
-            raise ConformanceError(f"{kind}.{key}={value!r} must be refused with a ConfigError naming "
-                                   f"'{kind}.{key}', but the config was accepted.")
+            raise ConformanceError(
+                f"{kind}.{key}={value!r} must be refused with a ConfigError naming "
+                f"'{kind}.{key}', but the config was accepted."
+            )
 
 
-def check_config_file(kind: str, cls: type, name: str) -> None:
+def check_config_file(kind: str, cls: type[Plugin], name: str) -> None:
     """Rule 2, the file: the option Hydra finds for ``kind=name`` has ``name: <name>`` and its
     values are ``cls.Config``'s defaults (the file documents them)."""
     from pegame.config import compose
 
     node = compose([f"{kind}={name}"])[kind]
-    _fail_unless(node.name == name, f"conf/{kind}/{name}.yaml must say 'name: {name}', not {node.name!r}.")
+    _fail_unless(
+        node.name == name, f"conf/{kind}/{name}.yaml must say 'name: {name}', not {node.name!r}."
+    )
     params = {k: v for k, v in node.items() if k != "name"}
     config, defaults = registry.make_config(kind, cls, params), cls.Config()
-    differ = {f.name: (getattr(config, f.name), getattr(defaults, f.name))
-              for f in dataclasses.fields(config) if getattr(config, f.name) != getattr(defaults, f.name)}
-    _fail_unless(not differ, f"conf/{kind}/{name}.yaml must hold {cls.__name__}.Config's defaults; "
-                 f"(file, default) differ for {differ}.")
+    differ = {
+        f.name: (getattr(config, f.name), getattr(defaults, f.name))
+        for f in dataclasses.fields(config)
+        if getattr(config, f.name) != getattr(defaults, f.name)
+    }
+    _fail_unless(
+        not differ,
+        f"conf/{kind}/{name}.yaml must hold {cls.__name__}.Config's defaults; "
+        f"(file, default) differ for {differ}.",
+    )
 
 
-def _game_overrides(kind: str, name: str, overrides: Sequence[str], env: str | None,
-                    t_max: float, seed: int) -> list[str]:
+def _global_generator_state() -> tuple[bytes, int]:
+    """Where numpy's legacy global generator (np.random.*) stands: its key and position."""
+    state = np.random.get_state(legacy=False)  # noqa: NPY002 - the global generator is the subject
+    assert isinstance(state, dict)
+    return bytes(state["state"]["key"]), int(state["state"]["pos"])
+
+
+def _game_overrides(
+    kind: str, name: str, overrides: Sequence[str], env: str | None, t_max: float, seed: int
+) -> list[str]:
     chosen = [f"{kind}={name}", f"game.t_max={t_max}", f"game.seed={seed}"]
     if kind != "recorder":
         chosen.append("recorder=none")
@@ -185,15 +232,22 @@ def _game_overrides(kind: str, name: str, overrides: Sequence[str], env: str | N
     return chosen + list(overrides)
 
 
-def check_same_seed_same_game(kind: str, name: str, overrides: Sequence[str] = (), *,
-                              env: str | None = None, t_max: float = 3.0, seed: int = 0) -> None:
+def check_same_seed_same_game(
+    kind: str,
+    name: str,
+    overrides: Sequence[str] = (),
+    *,
+    env: str | None = None,
+    t_max: float = 3.0,
+    seed: int = 0,
+) -> None:
     """Rule 3: two games with ``kind=name`` (plus Hydra ``overrides``, on ``env``, ``t_max``
     seconds, ``seed``) play the same, and leave numpy's global generator alone."""
     from pegame.config import compose
     from pegame.game import Game
 
     chosen = _game_overrides(kind, name, overrides, env, t_max, seed)
-    global_state = np.random.get_state()
+    global_state = _global_generator_state()
     outcomes = []
     with tempfile.TemporaryDirectory(prefix="pegame-conformance-") as out:
         for k in range(2):
@@ -201,29 +255,45 @@ def check_same_seed_same_game(kind: str, name: str, overrides: Sequence[str] = (
             out_dir.mkdir()
             outcomes.append(Game(compose(chosen)).play(out_dir))
     first, second = outcomes
-    _fail_unless(len(first.trajectory) == first.result["ticks"] > 0,
-                 f"A {t_max} s game must play every tick, got {len(first.trajectory)} rows.")
-    _fail_unless(first.result == second.result,
-                 f"Two games with {chosen} gave different results: {first.result} != {second.result}. "
-                 f"A plugin must draw only from the generator it is given (self.rng).")
-    differing = next((i for i, (a, b) in enumerate(zip(first.trajectory, second.trajectory))
-                      if a != b), None)
-    _fail_unless(differing is None, f"Two games with {chosen} diverge at tick {differing}: "
-                 f"{first.trajectory[differing or 0]} != {second.trajectory[differing or 0]}.")
-    state = np.random.get_state()
     _fail_unless(
-        state[0] == global_state[0] and np.array_equal(state[1], global_state[1])
-        and state[2:] == global_state[2:],
+        len(first.trajectory) == first.result["ticks"] > 0,
+        f"A {t_max} s game must play every tick, got {len(first.trajectory)} rows.",
+    )
+    _fail_unless(
+        first.result == second.result,
+        f"Two games with {chosen} gave different results: {first.result} != {second.result}. "
+        f"A plugin must draw only from the generator it is given (self.rng).",
+    )
+    differing = next(
+        (i for i, (a, b) in enumerate(zip(first.trajectory, second.trajectory)) if a != b), None
+    )
+    _fail_unless(
+        differing is None,
+        f"Two games with {chosen} diverge at tick {differing}: "
+        f"{first.trajectory[differing or 0]} != {second.trajectory[differing or 0]}.",
+    )
+    _fail_unless(
+        _global_generator_state() == global_state,
         f"A game with {chosen} drew from numpy's global generator (np.random.*); use self.rng.",
     )
     if kind != "recorder":
-        _fail_unless(first.result[kind] == name,
-                     f"The game's result names {kind} {first.result[kind]!r}, not {name!r}.")
+        _fail_unless(
+            first.result[kind] == name,
+            f"The game's result names {kind} {first.result[kind]!r}, not {name!r}.",
+        )
 
 
-def check_plugin(kind: str, cls: type, *, name: str | None = None, overrides: Sequence[str] = (),
-                 bad_values: Mapping[str, Any] | None = None, env: str | None = None,
-                 t_max: float = 3.0, seed: int = 0) -> None:
+def check_plugin(
+    kind: str,
+    cls: type[Plugin],
+    *,
+    name: str | None = None,
+    overrides: Sequence[str] = (),
+    bad_values: Mapping[str, Any] | None = None,
+    env: str | None = None,
+    t_max: float = 3.0,
+    seed: int = 0,
+) -> None:
     """Run every check on the ``kind`` plugin ``cls`` (registered as ``name``, found if
     None); raise ConformanceError on the first broken rule.
 
@@ -255,8 +325,10 @@ class PluginConformance:
     t_max: ClassVar[float] = 3.0
 
     @classmethod
-    def plugin_class(cls) -> type:
-        return registry.load(cls.kind, cls.plugin)
+    def plugin_class(cls) -> type[Plugin]:
+        """The plugin's class, as the registry loads it."""
+        loaded: type[Plugin] = registry.load(cls.kind, cls.plugin)
+        return loaded
 
     def test_implements_its_interface(self) -> None:
         check_interface(self.kind, self.plugin_class(), self.plugin)
@@ -268,7 +340,9 @@ class PluginConformance:
         check_config_file(self.kind, self.plugin_class(), self.plugin)
 
     def test_same_seed_same_game(self) -> None:
-        check_same_seed_same_game(self.kind, self.plugin, self.overrides, env=self.env, t_max=self.t_max)
+        check_same_seed_same_game(
+            self.kind, self.plugin, self.overrides, env=self.env, t_max=self.t_max
+        )
 
 
 class SimulatorConformance(PluginConformance):
@@ -309,8 +383,8 @@ def small_map() -> OccupancyGrid:
 
     data = np.zeros((60, 80), dtype=np.int8)
     col = int(round(WALL_X / RESOLUTION))
-    data[:40, col:col + 2] = 100
-    data[BLOCK[0]:BLOCK[1], BLOCK[2]:BLOCK[3]] = 100
+    data[:40, col : col + 2] = 100
+    data[BLOCK[0] : BLOCK[1], BLOCK[2] : BLOCK[3]] = 100
     data[55:, 75:] = -1
     return OccupancyGrid(data, RESOLUTION, name="small")
 
@@ -318,14 +392,23 @@ def small_map() -> OccupancyGrid:
 def small_context(grid: OccupancyGrid | None = None) -> Context:
     """A context with the default bodies and camera (pi/3 FOV, 0.3-5 m, 640x480 px), 10 Hz
     control and 1 Hz decisions, on ``grid`` (default :func:`small_map`)."""
-    return Context(grid if grid is not None else small_map(), Body(0.2, 0.5, 1.8),
-                   Body(0.25, 0.5, 1.8), Camera(fov=math.pi / 3), 0.1, 1.0)
+    return Context(
+        grid if grid is not None else small_map(),
+        Body(0.2, 0.5, 1.8),
+        Body(0.25, 0.5, 1.8),
+        Camera(fov=math.pi / 3),
+        0.1,
+        1.0,
+    )
 
 
 @contextmanager
 def _without(module: str, package: str) -> Iterator[None]:
-    saved = {name: mod for name, mod in sys.modules.items()
-             if name == module or name.startswith(module + ".") or name.split(".")[0] == package}
+    saved = {
+        name: mod
+        for name, mod in sys.modules.items()
+        if name == module or name.startswith(module + ".") or name.split(".")[0] == package
+    }
     for name in saved:
         del sys.modules[name]
     sys.modules[module] = None  # type: ignore[assignment]  # makes "import module" fail
@@ -337,7 +420,9 @@ def _without(module: str, package: str) -> Iterator[None]:
         sys.modules.update(saved)
 
 
-def missing_dependency_error(kind: str, name: str, module: str, package: str) -> registry.PluginError:
+def missing_dependency_error(
+    kind: str, name: str, module: str, package: str
+) -> registry.PluginError:
     """The PluginError of loading the ``kind`` plugin ``name`` (from the import package
     ``package``) as if ``module`` were not installed; fails if loading does not raise one.
     The message should name ``module``: assert that in the plugin's test."""

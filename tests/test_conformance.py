@@ -116,7 +116,7 @@ class Spiteful(Pursuer):
         return Plan()
 
     def control(self, observation):
-        return Velocity(0.0, float(np.random.uniform(-1.0, 1.0)))
+        return Velocity(0.0, float(np.random.uniform(-1.0, 1.0)))  # noqa: NPY002 - the defect tested
 
 
 class Lenient(Pursuer):
@@ -181,13 +181,15 @@ def test_a_plugin_drawing_from_the_global_generator_is_refused(monkeypatch):
         points = dict(real(group))
         if group == "pursuer":
             points["spiteful"] = registry.EntryPoint(
-                "spiteful", f"{__name__}:Spiteful", registry.GROUPS["pursuer"])
+                "spiteful", f"{__name__}:Spiteful", registry.GROUPS["pursuer"]
+            )
         return points
 
     monkeypatch.setattr(registry, "_entry_points", with_spiteful)
     # pursuer=spiteful has no config file: take random's (the body alone) and rename it.
     with pytest.raises(ConformanceError, match="different results|diverge"):
         check_same_seed_same_game("pursuer", "random", ["pursuer.name=spiteful"], t_max=2.0)
+
 
 def test_check_plugin_runs_every_rule_on_a_built_in():
     check_plugin("estimator", registry.load("estimator", "last_seen"), t_max=2.0)
