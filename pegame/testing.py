@@ -404,18 +404,20 @@ def small_context(grid: OccupancyGrid | None = None) -> Context:
 
 @contextmanager
 def _without(module: str, package: str) -> Iterator[None]:
-    saved = {
-        name: mod
-        for name, mod in sys.modules.items()
-        if name == module or name.startswith(module + ".") or name.split(".")[0] == package
-    }
+    """While inside: ``import module`` fails and ``package`` is imported afresh; after, both
+    are as they were."""
+
+    def affected(name: str) -> bool:
+        return name == module or name.startswith(module + ".") or name.split(".")[0] == package
+
+    saved = {name: mod for name, mod in sys.modules.items() if affected(name)}
     for name in saved:
         del sys.modules[name]
     sys.modules[module] = None  # type: ignore[assignment]  # makes "import module" fail
     try:
         yield
     finally:
-        for name in [n for n in sys.modules if n == module or n.split(".")[0] == package]:
+        for name in [n for n in sys.modules if affected(n)]:
             del sys.modules[name]
         sys.modules.update(saved)
 
