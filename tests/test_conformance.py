@@ -13,6 +13,7 @@ from pegame import registry
 from pegame.api import Pursuer, Velocity
 from pegame.errors import require
 from pegame.pursuers.random import RandomPursuer
+from pegame.pursuers.smart import SmartPursuer
 from pegame.testing import (
     ConformanceError,
     DetectorConformance,
@@ -22,6 +23,7 @@ from pegame.testing import (
     RecorderConformance,
     SimulatorConformance,
     check_config_errors,
+    check_config_file,
     check_interface,
     check_plugin,
     check_same_seed_same_game,
@@ -174,21 +176,61 @@ def test_a_config_that_accepts_a_bad_value_or_misnames_the_key_is_refused():
     check_config_errors("pursuer", Strict, {"radius": -1.0})  # the body's checks name their keys
 
 
-def test_a_plugin_drawing_from_the_global_generator_is_refused(monkeypatch):
-    real = registry._entry_points
+class Reseeding(Spiteful):
+    """Plays the same game twice, but by reseeding numpy's global generator."""
 
-    def with_spiteful(group):
+    def reset(self, pose):
+        np.random.seed(7)  # noqa: NPY002 - the defect tested
+
+
+@pytest.fixture
+def registered(monkeypatch):
+    """``registered(name, cls)``: make ``cls`` the pursuer plugin ``name`` of the registry."""
+    real = registry._entry_points
+    extra = {}
+
+    def with_extra(group):
         points = dict(real(group))
         if group == "pursuer":
-            points["spiteful"] = registry.EntryPoint(
-                "spiteful", f"{__name__}:Spiteful", registry.GROUPS["pursuer"]
-            )
+            points.update(extra)
         return points
 
-    monkeypatch.setattr(registry, "_entry_points", with_spiteful)
-    # pursuer=spiteful has no config file: take random's (the body alone) and rename it.
+    def register(name, cls):
+        extra[name] = registry.EntryPoint(
+            name, f"{__name__}:{cls.__name__}", registry.GROUPS["pursuer"]
+        )
+
+    monkeypatch.setattr(registry, "_entry_points", with_extra)
+    return register
+
+
+# A pursuer registered here has no config file: the games take random's (the body alone)
+# and rename it.
+
+
+def test_a_plugin_drawing_from_the_global_generator_is_refused(registered):
+    registered("spiteful", Spiteful)
     with pytest.raises(ConformanceError, match="different results|diverge"):
         check_same_seed_same_game("pursuer", "random", ["pursuer.name=spiteful"], t_max=2.0)
+
+
+def test_a_plugin_reseeding_the_global_generator_is_refused(registered):
+    registered("reseeding", Reseeding)
+    with pytest.raises(ConformanceError, match="numpy's global generator"):
+        check_same_seed_same_game("pursuer", "random", ["pursuer.name=reseeding"], t_max=2.0)
+
+
+class Shifted(SmartPursuer):
+    """The smart pursuer with a default that its config file does not hold."""
+
+    @dataclass
+    class Config(SmartPursuer.Config):
+        standoff: float = 2.0  # m
+
+
+def test_a_config_file_that_does_not_hold_the_defaults_is_refused():
+    with pytest.raises(ConformanceError, match="standoff"):
+        check_config_file("pursuer", Shifted, "smart")
 
 
 def test_check_plugin_runs_every_rule_on_a_built_in():
