@@ -7,19 +7,20 @@ import pytest
 pytest.importorskip("cv2")
 pytest.importorskip("pybullet")  # the frames are rendered by sim=pybullet
 
-import dataclasses  # noqa: E402
-import math  # noqa: E402
+import dataclasses
+import math
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from pegame.api import Context, SensorFrame  # noqa: E402
+from pegame.api import Context, SensorFrame
+from pegame.errors import ConfigError
+from pegame.grid import OccupancyGrid
+from pegame.testing import missing_dependency_error
 from pegame.types import Body, Camera, Pose
-from pegame.errors import ConfigError  # noqa: E402
-from pegame.grid import OccupancyGrid  # noqa: E402
-from pegame_pybullet.segmentation import SegmentationDetector  # noqa: E402
-from pegame_pybullet.sim import PybulletSimulator  # noqa: E402
-from pegame_vision.detector import VisionDetector  # noqa: E402
-from pegame_vision.evaluate import iou  # noqa: E402
+from pegame_pybullet.segmentation import SegmentationDetector
+from pegame_pybullet.sim import PybulletSimulator
+from pegame_vision.detector import VisionDetector
+from pegame_vision.evaluate import iou
 
 
 @pytest.fixture(scope="module")
@@ -29,7 +30,9 @@ def walk():
     grid = OccupancyGrid(np.zeros((80, 160), dtype=np.int8), 0.05, name="room")
     context = Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
     sim = PybulletSimulator(PybulletSimulator.Config(), context, np.random.default_rng(0))
-    reference = SegmentationDetector(SegmentationDetector.Config(), context, np.random.default_rng(0))
+    reference = SegmentationDetector(
+        SegmentationDetector.Config(), context, np.random.default_rng(0)
+    )
     frames = []
     try:
         for k in range(70):
@@ -53,24 +56,32 @@ def run(context, frames, **options):
 def test_finds_and_tracks_the_evader_across_the_view(walk):
     context, frames = walk
     found = run(context, frames)
-    seen = [(truth, mine, frame.evader_truth) for (frame, truth), (mine, _) in zip(frames, found) if truth]
+    seen = [
+        (truth, mine, frame.evader_truth)
+        for (frame, truth), (mine, _) in zip(frames, found)
+        if truth
+    ]
     assert 40 < len(seen) < len(frames)  # the walk starts and ends out of view
-    matched = [(mine, evader) for truth, mine, evader in seen if mine and iou(truth.box, mine.box) >= 0.5]
+    matched = [
+        (mine, evader) for truth, mine, evader in seen if mine and iou(truth.box, mine.box) >= 0.5
+    ]
     assert len(matched) >= 0.9 * len(seen)
     errors = [math.hypot(mine.position[0] - e.x, mine.position[1] - e.y) for mine, e in matched]
     assert np.median(errors) < 0.15
     sources = [source for _, source in found]
     assert sources.count("track") >= 0.5 * len(seen)  # Lucas-Kanade carries most frames
     assert "detect" in sources
-    for (frame, truth), (mine, _) in zip(frames, found):
+    for (_, truth), (mine, _) in zip(frames, found):
         if truth is None:
             assert mine is None
 
 
 def test_reads_only_the_rgb_d_image_and_calibration(walk):
     context, frames = walk
-    blind = [(dataclasses.replace(frame, segmentation=None, labels=None, evader_truth=None), truth)
-             for frame, truth in frames]
+    blind = [
+        (dataclasses.replace(frame, segmentation=None, labels=None, evader_truth=None), truth)
+        for frame, truth in frames
+    ]
     assert [d for d, _ in run(context, blind)] == [d for d, _ in run(context, frames)]
 
 
@@ -91,7 +102,7 @@ def test_bad_colours_are_config_errors():
         VisionDetector.Config(colours=["red"])
 
 
-def test_missing_opencv_is_an_import_error_naming_it(load_without):
-    error = load_without("cv2", "pegame_vision", "detector", "vision")
+def test_missing_opencv_is_an_import_error_naming_it():
+    error = missing_dependency_error("detector", "vision", "cv2", "pegame_vision")
     assert "cv2" in str(error) and "pip install opencv-python-headless" in str(error)
     assert isinstance(error.__cause__, ImportError)

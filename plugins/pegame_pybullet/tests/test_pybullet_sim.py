@@ -7,21 +7,20 @@ import pytest
 
 pytest.importorskip("pybullet")
 
-import dataclasses  # noqa: E402
-import math  # noqa: E402
+import dataclasses
+import math
 
-import numpy as np  # noqa: E402
-import pybullet  # noqa: E402
+import numpy as np
+import pybullet
 
-from pegame.api import Velocity  # noqa: E402
+from pegame.api import Velocity
+from pegame.errors import ConfigError
+from pegame.grid import OccupancyGrid
+from pegame.testing import WALL_X, missing_dependency_error
 from pegame.types import Pose
-from pegame.errors import ConfigError  # noqa: E402
-from pegame.grid import OccupancyGrid  # noqa: E402
-from pegame_pybullet.bench import _rss_mb  # noqa: E402
-from pegame_pybullet.sim import PybulletSimulator  # noqa: E402
-from pegame_pybullet.world import merge_rectangles  # noqa: E402
-
-from plugin_worlds import WALL_X  # noqa: E402
+from pegame_pybullet.bench import _rss_mb
+from pegame_pybullet.sim import PybulletSimulator
+from pegame_pybullet.world import merge_rectangles
 
 
 def make_sim(context, **options) -> PybulletSimulator:
@@ -42,7 +41,7 @@ def test_rectangles_cover_the_mask_exactly_without_overlap():
         mask = rng.random((int(rng.integers(1, 30)), int(rng.integers(1, 30)))) < rng.random()
         cover = np.zeros(mask.shape, dtype=int)
         for row, col, h, w in merge_rectangles(mask):
-            cover[row:row + h, col:col + w] += 1
+            cover[row : row + h, col : col + w] += 1
         assert np.array_equal(cover, mask.astype(int))
     assert len(merge_rectangles(np.ones((300, 300), dtype=bool))) == 1
 
@@ -54,12 +53,18 @@ def test_walls_are_exactly_where_the_map_has_them(context, origin):
     sim.place(*[Pose(*grid.cell_to_world(5, 5), 0.0)] * 2)
     # A vertical ray from above the 2 m walls down through every cell centre, and through
     # the ring around the grid.
-    rows, cols = np.mgrid[-1:grid.height + 1, -1:grid.width + 1]
+    rows, cols = np.mgrid[-1 : grid.height + 1, -1 : grid.width + 1]
     x, y = grid.cell_to_world(rows.ravel(), cols.ravel())
     starts = np.column_stack([x, y, np.full(x.size, 3.0)])
     ends = starts * [1, 1, 0] + [0, 0, 0.1]
-    hits = np.array([hit[0] for hit in pybullet.rayTestBatch(starts.tolist(), ends.tolist(),
-                                                              physicsClientId=sim._client.id)])
+    hits = np.array(
+        [
+            hit[0]
+            for hit in pybullet.rayTestBatch(
+                starts.tolist(), ends.tolist(), physicsClientId=sim._client.id
+            )
+        ]
+    )
     walls = np.isin(hits, sim.world.walls).reshape(rows.shape)
     sim.close()
     expected = np.pad(grid.blocked, 1, constant_values=True)
@@ -165,7 +170,7 @@ def test_reset_close_cycles_keep_memory_flat(context):
     assert _rss_mb() - before < 5.0
 
 
-def test_missing_pybullet_is_an_import_error_naming_it(load_without):
-    error = load_without("pybullet", "pegame_pybullet", "sim", "pybullet")
+def test_missing_pybullet_is_an_import_error_naming_it():
+    error = missing_dependency_error("sim", "pybullet", "pybullet", "pegame_pybullet")
     assert "pybullet" in str(error) and "pip install pybullet" in str(error)
     assert isinstance(error.__cause__, ImportError)

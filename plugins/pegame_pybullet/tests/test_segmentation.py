@@ -6,29 +6,37 @@ import pytest
 
 pytest.importorskip("pybullet")
 
-import math  # noqa: E402
+import math
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from pegame.api import SensorFrame  # noqa: E402
+from pegame.api import SensorFrame
+from pegame.errors import ConfigError
 from pegame.types import Pose
-from pegame.errors import ConfigError  # noqa: E402
-from pegame_pybullet.segmentation import SegmentationDetector  # noqa: E402
-from pegame_pybullet.sim import PybulletSimulator  # noqa: E402
+from pegame_pybullet.segmentation import SegmentationDetector
+from pegame_pybullet.sim import PybulletSimulator
 
 
 @pytest.fixture
 def scene(context):
     """(sim, detector) on the small map, with a level camera."""
     sim = PybulletSimulator(PybulletSimulator.Config(), context, np.random.default_rng(0))
-    detector = SegmentationDetector(SegmentationDetector.Config(), context, np.random.default_rng(0))
+    detector = SegmentationDetector(
+        SegmentationDetector.Config(), context, np.random.default_rng(0)
+    )
     yield sim, detector
     sim.close()
 
 
 @pytest.mark.parametrize(
     ("x", "y", "heading"),
-    [(1.5, 1.0, 0.0), (1.2, 1.4, math.pi / 2), (1.6, 0.7, 2.0), (1.0, 1.0, -1.0), (0.8, 1.2, math.pi)],
+    [
+        (1.5, 1.0, 0.0),
+        (1.2, 1.4, math.pi / 2),
+        (1.6, 0.7, 2.0),
+        (1.0, 1.0, -1.0),
+        (0.8, 1.2, math.pi),
+    ],
 )
 def test_the_evader_in_front_is_found_and_placed_within_10_cm(scene, context, x, y, heading):
     sim, detector = scene
@@ -43,12 +51,17 @@ def test_the_evader_in_front_is_found_and_placed_within_10_cm(scene, context, x,
     column = camera.column_of(math.atan2(y - 1.0, x - 0.3))
     box = detection.box
     assert box.x < column < box.x + box.w
-    assert 0 <= box.x and box.x + box.w <= camera.image_width and box.y + box.h <= camera.image_height
+    assert (
+        0 <= box.x and box.x + box.w <= camera.image_width and box.y + box.h <= camera.image_height
+    )
 
 
 def test_no_detection_behind_a_wall_behind_the_camera_or_beyond_range(scene, context):
     sim, detector = scene
-    for evader in (Pose(2.6, 1.0, 0.0), Pose(1.5, 2.7, 0.0)):  # behind the wall; pursuer looks at it
+    for evader in (
+        Pose(2.6, 1.0, 0.0),
+        Pose(1.5, 2.7, 0.0),
+    ):  # behind the wall; pursuer looks at it
         sim.reset(Pose(0.5, 1.0, 0.0), evader)
         assert detector.detect(sim.sense(0.0)) is None
     sim.reset(Pose(1.0, 1.0, math.pi), Pose(1.6, 1.0, 0.0))  # behind the camera
@@ -71,6 +84,8 @@ def test_an_evader_beyond_the_camera_range_is_not_detected(context):
 
 
 def test_frames_without_segmentation_are_a_clear_error(context):
-    detector = SegmentationDetector(SegmentationDetector.Config(), context, np.random.default_rng(0))
+    detector = SegmentationDetector(
+        SegmentationDetector.Config(), context, np.random.default_rng(0)
+    )
     with pytest.raises(ConfigError, match="sim=pybullet"):
         detector.detect(SensorFrame(time=0.0, camera_pose=Pose(0, 0), evader_truth=Pose(1, 0)))
