@@ -25,8 +25,8 @@ that, bit for bit), in numba kernels that skip most of the work:
   distance, computed as the Euclidean distance transform computes it, is within the
   margin, so the grown V is the transform's.
 - The candidate cells of the evader's connected component are built once per component
-  and grouped in square tiles (:data:`_COMPONENTS` keeps them across games, per planner
-  and candidate stride). Tiles are scored in increasing order of a lower bound of
+  and grouped in square tiles (kept on the grid across games by
+  :func:`pegame.grid.per_grid`, per planner radius and candidate stride). Tiles are scored in increasing order of a lower bound of
   their cost (the nearest distance to the evader over the farthest distance to the
   pursuer), and the search stops at the first tile whose bound exceeds the best cost
   found by more than round-off could explain (a relative slack of 1e-9). Ties are broken
@@ -39,7 +39,6 @@ that, bit for bit), in numba kernels that skip most of the work:
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -47,7 +46,7 @@ import numpy as np
 from numba import njit
 from scipy.ndimage import distance_transform_edt
 
-from pegame.grid import OccupancyGrid
+from pegame.grid import OccupancyGrid, per_grid
 from pegame.navigation import Planner
 from pegame.types import Camera, Pose
 from pegame.visibility import VisibilityRegion, visibility_region
@@ -224,10 +223,6 @@ def _sample_positions(skipped, count, step):
 # ------------------------------------------------------------------ candidate cells
 
 
-#: the components built so far, by planner (shared per map and radius) and candidate stride
-_COMPONENTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
 @dataclass(frozen=True, eq=False)
 class _Component:
     """The candidate cells (on the candidate stride) of one connected component.
@@ -361,7 +356,9 @@ class EscapeSearch:
         disjoint, and shared by every evader with the same planner and candidate stride),
         else a new one."""
         grid = self.grid
-        shared = _COMPONENTS.setdefault(self.planner, {}).setdefault(self.candidate_stride, [])
+        # Components depend on the traversable cells (the planner's radius) and the stride.
+        key = ("evaders.escape", "components", self.planner.radius, self.candidate_stride)
+        shared = per_grid(grid, key, lambda grid: [])
         row, col = grid.world_to_cell(me.x, me.y)
         on_grid = 0 <= row < grid.height and 0 <= col < grid.width
         source = None

@@ -19,11 +19,13 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
+from pegame.grid import per_grid, read_only
+from pegame.navigation.inflation import shared_obstacle_distance
 from pegame.types import Camera
 
 #: points along the near arc of an outline (the arc is short: near is a few decimetres)
@@ -143,29 +145,13 @@ def free_runs(grid) -> np.ndarray:
 
     If the cell's centre lies D cells from the nearest blocked cell's centre or cell off
     the grid, every point closer than D - sqrt(2) cells to a point of the cell is free: 1 +
-    floor(D - 1.5) samples (at least 1, at most 255). Small, so it stays in cache. Kept for
-    the next games of the process on the same grid.
+    floor(D - 1.5) samples (at least 1, at most 255). Small, so it stays in cache. Kept on
+    the grid for its next games (:func:`pegame.grid.per_grid`).
     """
-    return per_grid("free_runs", grid, _free_runs)
+    return per_grid(grid, ("visibility.outlines", "free runs"), _free_runs)
 
 
 def _free_runs(grid) -> np.ndarray:
-    from scipy.ndimage import distance_transform_edt
-
-    free = np.pad(~grid.blocked, 1, constant_values=False)
-    clearance = distance_transform_edt(free)[1:-1, 1:-1]
+    clearance = shared_obstacle_distance(grid) / grid.resolution  # cells
     runs = np.where(grid.blocked, 0, 1 + np.clip(np.floor(clearance - 1.5), 0, 254))
-    return runs.astype(np.uint8)
-
-
-_PER_GRID: dict[str, tuple[Any, Any]] = {}
-
-
-def per_grid(name: str, grid, build):
-    """``build(grid)``, kept under ``name`` for the next games of the process on the same
-    grid (grids are immutable; one grid per name is kept). Also keeps the recorder's map
-    payload; both move to the shared per-grid cache of :mod:`pegame.grid`."""
-    hit = _PER_GRID.get(name)
-    if hit is None or hit[0] is not grid:
-        hit = _PER_GRID[name] = (grid, build(grid))
-    return hit[1]
+    return read_only(runs.astype(np.uint8))

@@ -25,7 +25,8 @@ from pegame.recorders.rerun.columns import (
 )
 from pegame.types import Camera, Plan, Pose
 from pegame.visibility import fov_wedge
-from pegame.visibility.outlines import per_grid, visibility_outlines
+from pegame.grid import per_grid
+from pegame.visibility.outlines import visibility_outlines
 
 PURSUER = (220, 40, 40, 255)
 EVADER = (30, 160, 60, 255)
@@ -49,7 +50,7 @@ def log_static(rec: rr.RecordingStream, context: Context, properties: dict[str, 
     """The map, the image border, the FOV wedge, the config document and every style."""
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     # The map is static; building its payload is the larger part of starting a recording.
-    rec.log("world/map", per_grid("grid_map", context.grid, grid_map), static=True)
+    rec.log("world/map", per_grid(context.grid, ("recorders.rerun", "map"), grid_map), static=True)
     w, h = context.camera.image_width, context.camera.image_height
     border = [[(0, 0), (w, 0), (w, h), (0, h), (0, 0)]]
     rec.log("camera/frame", rr.LineStrips2D(border, colors=[(128, 128, 128)]), static=True)
