@@ -1,4 +1,11 @@
-"""Angle arithmetic for numba kernels: a vectorisable sine-cosine and the angle wrap.
+"""Elementary functions for numba kernels that give the same bits on every CPU: a
+vectorisable sine-cosine, the exponential and the angle wrap.
+
+Numba compiles these without fastmath, so LLVM neither reorders nor fuses their floating-
+point operations and the result does not depend on the CPU's vector width or on FMA;
+numpy's own exp, log, arctan2 and tanh dispatch to AVX2 or AVX-512 loops that differ in
+the last ulp from the generic ones (``tests/test_determinism.py``), and glibc's exp has an
+FMA variant, so neither is used where it decides a game.
 
 Sine and cosine of one angle as a branch-free polynomial, for loops that numba vectorises.
 
@@ -12,6 +19,10 @@ over an array, LLVM turns it into SIMD code: about four times faster than libm f
 angles. For |angle| <= MAX_ANGLE rad the results differ from libm's by at most 2^-52
 (one ulp of 1; the tests hold it to that); beyond, the reduction loses accuracy and
 callers must use libm.
+
+:func:`exps` is fdlibm's ``__ieee754_exp`` (the reduction x = k ln 2 + r with a
+two-part ln 2, and its degree-5 minimax polynomial for r / (exp(r) - 1)), less than one
+ulp from the exact value, for the arguments that give a normal result.
 
 The angle wrap onto (-pi, pi] is defined once, as numpy computes ``pi - ((pi - angle) mod
 2 pi)`` (:func:`wrap_angles_reference`): :func:`wrap_angle_kernel` is that for one angle in
@@ -40,6 +51,42 @@ _S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.9841
 _S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
 _C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
 _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
+
+
+_LN2_HIGH = 6.93147180369123816490e-01  # first 32 bits of ln 2
+_LN2_LOW = 1.90821492927058770002e-10  # ln 2 - _LN2_HIGH
+_INV_LN2 = 1.44269504088896338700e00
+_P1, _P2, _P3 = 1.66666666666666019037e-01, -2.77777777770155933842e-03, 6.61375632143793436117e-05
+_P4, _P5 = -1.65339022054652515390e-06, 4.13813679705723846039e-08
+#: exp(x) is below the smallest normal float (2.2e-308) for x below this; exps gives 0
+EXP_NORMAL_MIN = -708.0
+#: the largest argument of exps (the scale 2^k must stay a normal float)
+EXP_MAX = 709.0
+
+
+@njit(cache=True)
+def exps(x):
+    """exp of every element of the float array ``x`` (fdlibm's algorithm, < 1 ulp), each
+    at most EXP_MAX; 0 where it is below EXP_NORMAL_MIN (also -inf), where the exact value
+    would be subnormal or below. Branch-free, so numba vectorises it."""
+    n = x.size
+    out = np.empty(n)
+    bits = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        low = x[i] < EXP_NORMAL_MIN
+        xi = 0.0 if low else x[i]  # keeps the reduction finite; the select below gives 0
+        k = np.floor(xi * _INV_LN2 + 0.5)  # a float: math.floor's int stops vectorisation
+        hi = xi - k * _LN2_HIGH
+        lo = k * _LN2_LOW
+        r = hi - lo
+        t = r * r
+        c = r - t * (_P1 + t * (_P2 + t * (_P3 + t * (_P4 + t * _P5))))
+        out[i] = 0.0 if low else 1.0 - ((lo - (r * c) / (2.0 - c)) - hi)
+        bits[i] = (np.int64(k) + 1023) << 52  # the float 2^k
+    scale = bits.view(np.float64)
+    for i in range(n):
+        out[i] *= scale[i]  # exact: a power of two, and the product stays normal
+    return out
 
 
 @njit(cache=True, inline="always")

@@ -68,3 +68,16 @@ def test_wraps_land_in_minus_pi_to_pi_and_agree_with_the_scalar_wrap_within_ulps
     gap = np.minimum(gap, 2.0 * math.pi - gap)  # pi and -pi are the same angle
     assert np.max(gap) <= 4 * np.spacing(math.pi) * (1 + np.abs(angles).max() / math.pi)
 
+
+
+def test_exps_is_within_one_ulp_of_libm_and_zero_below_the_normal_range():
+    from pegame.trig import EXP_MAX, EXP_NORMAL_MIN, exps
+
+    rng = np.random.default_rng(41)
+    xs = np.concatenate([rng.uniform(EXP_NORMAL_MIN, EXP_MAX, 20000), rng.uniform(-2.0, 2.0, 20000),
+                         [0.0, -0.0, 1e-300, -1e-300, math.log(2.0), -math.log(2.0), 1.0, -1.0,
+                          EXP_NORMAL_MIN, EXP_MAX]])
+    for x, ours in zip(xs, exps(xs)):
+        exact = math.exp(x)
+        assert abs(ours - exact) <= math.ulp(exact), x
+    assert np.all(exps(np.array([EXP_NORMAL_MIN - 1e-9, -745.0, -1e308, -math.inf])) == 0.0)
