@@ -78,7 +78,7 @@ def test_import_pegame_loads_no_plugin():
 
 def test_plugins_listing_shows_every_plugin_with_its_distribution():
     out = subprocess.run(
-        [sys.executable, "-m", "pegame.plugins"], capture_output=True, text=True, check=True
+        [sys.executable, "-m", "pegame.catalog"], capture_output=True, text=True, check=True
     ).stdout
     for group, ep_group in registry.GROUPS.items():
         assert f"{group} ({ep_group})" in out
