@@ -129,6 +129,10 @@ def main() -> None:
     try:
         check_plugin_choices(sys.argv[1:])
         _app()
+    except SystemExit as exc:
+        if exc.code == 1 and not sweep.began():
+            sys.exit(sweep.BAD_INPUT)  # Hydra rejected the command line before any job ran
+        raise
     except PluginChoiceError as exc:
         print(f"pegame: error: {exc}", file=sys.stderr)  # before Hydra: no job log yet
         sys.exit(sweep.BAD_INPUT)

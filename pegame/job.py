@@ -62,8 +62,9 @@ class JobRun:
 
 
 def read_lines(path: Path) -> Iterator[dict[str, Any]]:
-    """The entries of a results.jsonl; lines truncated by a killed job are skipped."""
-    if path.exists():
+    """The entries of a results.jsonl; lines truncated by a killed job are skipped (and
+    anything but a regular file holds none)."""
+    if path.is_file():
         for line in path.read_text().splitlines():
             try:
                 yield json.loads(line)

@@ -20,11 +20,11 @@ PACKAGE = Path(__file__).resolve().parent
 
 
 def cache_is_cold(package: Path = PACKAGE) -> bool:
-    """True when numba's cache holds no index of any kernel of ``package``."""
-    if any(package.rglob("__pycache__/*.nbi")):
-        return False
+    """True when numba's cache holds no index of any kernel of ``package`` (numba keeps
+    them under NUMBA_CACHE_DIR when it is set, else beside the modules)."""
     cache_dir = os.environ.get("NUMBA_CACHE_DIR")
-    return not (cache_dir and any(Path(cache_dir).rglob("*.nbi")))
+    found = Path(cache_dir).rglob("*.nbi") if cache_dir else package.rglob("__pycache__/*.nbi")
+    return next(found, None) is None
 
 
 @lru_cache(maxsize=1)
