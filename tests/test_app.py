@@ -179,3 +179,21 @@ def test_a_full_disk_is_one_clear_error_and_the_result_is_printed(tmp_path):
     assert f"Could not write to {tmp_path / 'run' / 'results.jsonl'}: No space left" in proc.stderr
     printed = [line for line in proc.stderr.splitlines() if line.startswith('{"kind": "game"')]
     assert json.loads(printed[0])["map"] == "hall"
+
+
+def test_the_first_run_says_once_that_it_compiles_the_kernels(tmp_path, monkeypatch, caplog):
+    from pegame import job, kernel_cache
+    from pegame.config import compose
+
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    job.run_job(compose([*FAST, "env=hall"]), tmp_path / "warm")
+    assert not kernel_cache.cache_is_cold()  # numba wrote its cache where pegame looks
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))  # an empty cache: a new install
+    assert kernel_cache.cache_is_cold()
+    kernel_cache.announce_compilation.cache_clear()
+    with caplog.at_level("INFO", logger="pegame"):
+        assert kernel_cache.announce_compilation()
+        kernel_cache.announce_compilation()
+    said = [r.message for r in caplog.records if "compiling pegame's numba kernels" in r.message]
+    assert len(said) == 1 and "half a minute" in said[0]
+    kernel_cache.announce_compilation.cache_clear()
