@@ -21,9 +21,11 @@ from typing import Sequence
 
 import hydra
 from hydra.core.hydra_config import HydraConfig
+from hydra.errors import HydraException
 from hydra.types import RunMode
 from hydra.utils import get_original_cwd
 from omegaconf import DictConfig, OmegaConf, open_dict
+from omegaconf.errors import OmegaConfBaseException
 
 from pegame import sweep
 from pegame.api import PLUGIN_KINDS
@@ -130,8 +132,8 @@ def main() -> None:
         check_plugin_choices(sys.argv[1:])
         _app()
     except SystemExit as exc:
-        if exc.code == 1 and not sweep.began():
-            sys.exit(sweep.BAD_INPUT)  # Hydra rejected the command line before any job ran
+        if exc.code == 1 and isinstance(exc.__context__, (HydraException, OmegaConfBaseException)):
+            sys.exit(sweep.BAD_INPUT)  # Hydra reported (and exited on) a bad command line
         raise
     except PluginChoiceError as exc:
         print(f"pegame: error: {exc}", file=sys.stderr)  # before Hydra: no job log yet

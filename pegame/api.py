@@ -44,9 +44,9 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 __all__ = [
     "EMPTY_BELIEF", "STOP", "Belief", "Body", "BoundingBox", "Camera", "Context", "Detection",
-    "Detector", "Estimator", "Evader", "EvaderObservation", "INTERFACES", "PLUGIN_KINDS", "Plan", "Plugin", "PluginKind",
-    "Pose", "Pursuer", "PursuerObservation", "Recorder", "SensorFrame", "Simulator",
-    "Strategy", "Tick", "Velocity", "clamp", "wrap_angle",
+    "Detector", "Estimator", "Evader", "EvaderObservation", "INTERFACES", "PLUGIN_KINDS", "Plan",
+    "Plugin", "PluginKind", "Pose", "Pursuer", "PursuerObservation", "Recorder", "SensorFrame",
+    "Simulator", "Strategy", "Tick", "Velocity", "clamp", "wrap_angle",
 ]
 
 

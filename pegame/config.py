@@ -167,7 +167,8 @@ def typed(node: Mapping[str, Any], schema: type, key: str) -> Any:
     unknown = sorted(set(params) - set(allowed))
     if unknown:
         raise ConfigError(
-            f"Unknown key '{key}.{unknown[0]}'.{did_you_mean(unknown[0], allowed)} "
+            f"Unknown key '{key}.{unknown[0]}'."
+            f"{did_you_mean(f'{key}.{unknown[0]}', [f'{key}.{name}' for name in allowed])} "
             f"Allowed keys under '{key}': {', '.join(allowed)}."
         )
     try:

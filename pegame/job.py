@@ -245,7 +245,9 @@ def write_single(outcome: Outcome, game: Game, out_dir: Path) -> None:
         ) from None
 
 
-def record_failure(out_dir: Path, seed: int, cfg: DictConfig, exc: Exception, identity: dict[str, Any]) -> None:
+def record_failure(
+    out_dir: Path, seed: int, cfg: DictConfig, exc: Exception, identity: dict[str, Any]
+) -> None:
     """Log a failed game, keep its traceback, and append a 'failed' line naming the seed
     and the cause."""
     text = "".join(traceback.format_exception(exc))

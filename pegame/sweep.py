@@ -29,19 +29,12 @@ STATUS_DIR_ENV = "PEGAME_STATUS_DIR"
 SWEEP_PID_ENV = "PEGAME_SWEEP_PID"
 
 _worst = OK
-_began = False  # whether a job or a sweep ran in this process
 
 
 def record(status: int) -> None:
     """Note the status of a job (or a whole sweep) run by this process."""
-    global _worst, _began
-    _worst, _began = max(_worst, status), True
-
-
-def began() -> bool:
-    """Whether a job or a sweep ran in this process: if not, an error came from composing
-    the config (Hydra's own checks of the command line), which is bad input."""
-    return _began or STATUS_DIR_ENV in os.environ
+    global _worst
+    _worst = max(_worst, status)
 
 
 def worst() -> int:

@@ -76,6 +76,8 @@ def test_any_ros_map_by_absolute_path(tmp_path):
         (["game.t_max=0.01"], "at least one control tick"),
         (["game.decision_hz=3"], "10, 5, 3.33333, 2.5, 2"),
         (["game.t_maxx=3"], "game.t_maxx"),
+        (["-m", "game.t_max=5,abc"], "game.t_max"),
+        (["game.t_max=[1"], "override_grammar"),
         (["game.t_max=abc"], "game.t_max"),
         (["evader.v_max=0"], "evader.v_max"),
         (["game.control_hz=-10"], "game.control_hz"),
