@@ -166,7 +166,7 @@ def test_multirun_through_submitit_local(tmp_path):
 
 # --- interrupting a sweep -------------------------------------------------------------
 
-TRIALS = 30
+TRIALS = 50  # enough games that the sweep is still running when it is interrupted
 SWEEP = [*SHORT, f"game.trials={TRIALS}", "pursuer=random", "evader=random,smart", "hydra/launcher=joblib",
          "hydra.launcher.n_jobs=2"]
 
