@@ -149,15 +149,13 @@ def run_job(
         return _run_locked(cfg, out_dir, base_dir, list(overrides))
 
 
-def _run_locked(cfg: DictConfig, out_dir: Path, base_dir: str | Path | None, overrides: list[str]) -> JobRun:
-    check_known_keys(cfg)
-    settings = typed(cfg.game, GameConfig, "game")
+def _run_locked(
+    cfg: DictConfig, out_dir: Path, base_dir: str | Path | None, overrides: list[str]
+) -> JobRun:
+    settings, first = checked_first_game(cfg, base_dir)
     config = job_config(cfg)
     results_path = out_dir / RESULTS
     stored = stored_seeds(results_path, config)
-    announce_compilation()
-    first = Game(with_seed(cfg, settings.seed), base_dir=base_dir)  # validates every node
-    check_room_to_spawn(first)
     done = stored if cfg.get("resume", False) else set()
     seeds = [s for s in range(settings.seed, settings.seed + settings.trials) if s not in done]
     if done:
@@ -191,6 +189,18 @@ def _run_locked(cfg: DictConfig, out_dir: Path, base_dir: str | Path | None, ove
         "status": run.status,
     })
     return run
+
+
+def checked_first_game(cfg: DictConfig, base_dir: str | Path | None) -> tuple[GameConfig, Game]:
+    """The game settings and the job's first game, built: building it checks everything
+    that does not depend on the seed (every key, the map, every plugin and its options),
+    so a bad value fails here, before any game is played."""
+    check_known_keys(cfg)
+    settings = typed(cfg.game, GameConfig, "game")
+    announce_compilation()
+    first = Game(with_seed(cfg, settings.seed), base_dir=base_dir)
+    check_room_to_spawn(first)
+    return settings, first
 
 
 def check_room_to_spawn(game: Game) -> None:

@@ -63,6 +63,12 @@ def _entry_points(group: str) -> dict[str, EntryPoint]:
     return unique_by_name(entry_points(group=_entry_point_group(group)))
 
 
+def refresh() -> None:
+    """Discover the entry points again (after installing or removing a plugin
+    distribution in a running session, e.g. a notebook)."""
+    _entry_points.cache_clear()
+
+
 def available(group: str) -> list[str]:
     """Names registered in ``group`` (for example ``available('pursuer')``), sorted."""
     return list(_entry_points(group))

@@ -93,7 +93,7 @@ def test_two_distributions_registering_one_name_warn_and_the_choice_is_stable():
 
 def test_the_installed_plugins_have_no_duplicate_names(recwarn):
     for group in registry.GROUPS:
-        registry._entry_points.cache_clear()
+        registry.refresh()
         registry.available(group)
     assert not [w for w in recwarn if "register the plugin name" in str(w.message)]
 
