@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 
 import numpy as np
 
@@ -44,9 +44,9 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 __all__ = [
     "EMPTY_BELIEF", "STOP", "Belief", "Body", "BoundingBox", "Camera", "Context", "Detection",
-    "Detector", "Estimator", "Evader", "EvaderObservation", "INTERFACES", "Plan", "Plugin",
-    "Pose", "Pursuer", "PursuerObservation", "Recorder", "Region", "SensorFrame", "Simulator",
-    "Strategy", "Tick", "Velocity", "clamp", "wrap_angle",
+    "Detector", "Estimator", "Evader", "EvaderObservation", "INTERFACES", "PLUGIN_KINDS", "Plan",
+    "Plugin", "PluginKind", "Pose", "Pursuer", "PursuerObservation", "Recorder", "Region",
+    "SensorFrame", "Simulator", "Strategy", "Tick", "Velocity", "clamp", "wrap_angle",
 ]
 
 
@@ -128,7 +128,7 @@ class Plugin(ABC):
     """Base of every plugin: holds its validated config, the game context and its RNG.
 
     Subclasses set ``Config`` to a dataclass of their parameters and ``description`` to a
-    one-line summary shown by ``python -m pegame.plugins``.
+    one-line summary shown by ``python -m pegame.catalog``.
     """
 
     @dataclass
@@ -276,12 +276,24 @@ class Recorder(Plugin):
         instead of :meth:`finish`); the recording should say that the game failed."""
 
 
-#: entry-point group suffix and interface, per config group
-INTERFACES: dict[str, type[Plugin]] = {
-    "sim": Simulator,
-    "detector": Detector,
-    "estimator": Estimator,
-    "pursuer": Pursuer,
-    "evader": Evader,
-    "recorder": Recorder,
+class PluginKind(NamedTuple):
+    """A kind of plugin: the interface its classes implement and the entry-point group
+    they register under."""
+
+    interface: type[Plugin]
+    entry_point_group: str
+
+
+#: the one list of plugin kinds, in the order a game builds them; the config group of a
+#: kind is its key (``pursuer=smart`` picks the ``smart`` entry point of ``pegame.pursuers``)
+PLUGIN_KINDS: dict[str, PluginKind] = {
+    "sim": PluginKind(Simulator, "pegame.simulators"),
+    "detector": PluginKind(Detector, "pegame.detectors"),
+    "estimator": PluginKind(Estimator, "pegame.estimators"),
+    "pursuer": PluginKind(Pursuer, "pegame.pursuers"),
+    "evader": PluginKind(Evader, "pegame.evaders"),
+    "recorder": PluginKind(Recorder, "pegame.recorders"),
 }
+
+#: kind -> interface, derived from :data:`PLUGIN_KINDS`
+INTERFACES: dict[str, type[Plugin]] = {kind: spec.interface for kind, spec in PLUGIN_KINDS.items()}

@@ -1,4 +1,5 @@
-"""Hydra callbacks: write the sweep report when a multirun ends."""
+"""Hydra callbacks of a multirun, run in the sweep's process: collect the jobs' exit
+statuses and write the sweep report."""
 
 from __future__ import annotations
 
@@ -8,7 +9,22 @@ from typing import Any
 from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
+from pegame import sweep
+
 log = logging.getLogger("pegame")
+
+
+class ExitStatusCallback(Callback):
+    """Gives the jobs of a multirun a status directory and collects their statuses at the
+    end, so ``python -m pegame -m ...`` exits with the worst (see :mod:`pegame.sweep`)."""
+
+    def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
+        sweep.start_sweep(config.hydra.sweep.dir)
+
+    def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
+        status = sweep.end_sweep()
+        if status != sweep.OK:
+            log.warning("some jobs of the sweep did not finish every game (exit status %d)", status)
 
 
 class ReportCallback(Callback):

@@ -10,6 +10,7 @@ Hydra applies at composition (unknown keys, wrong types) and range checks that
 
 from __future__ import annotations
 
+import difflib
 import math
 from dataclasses import dataclass, field, fields, make_dataclass
 from importlib.metadata import entry_points
@@ -23,6 +24,7 @@ from hydra.plugins.search_path_plugin import SearchPathPlugin
 from omegaconf import MISSING, DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
+from pegame.api import PLUGIN_KINDS
 from pegame.types import Camera
 from pegame.errors import ConfigError, require
 
@@ -39,17 +41,38 @@ class GameConfig:
     trials: int = 1  # games in one job, with seeds seed, seed + 1, ...
 
     def __post_init__(self) -> None:
+        require(self.seed >= 0, "game.seed", "a whole number >= 0 (numpy's SeedSequence)", self.seed)
         require(self.t_max > 0, "game.t_max", "a positive duration in seconds", self.t_max)
         require(self.trials >= 1, "game.trials", "a whole number >= 1", self.trials)
         for key in ("control_hz", "decision_hz", "speed_ratio"):
             value = getattr(self, key)
             require(value > 0 and math.isfinite(value), f"game.{key}", "a positive number", value)
         require(
+            self.ticks >= 1,
+            "game.t_max",
+            f"at least one control tick, {1 / self.control_hz:g} s at game.control_hz={self.control_hz:g}",
+            self.t_max,
+        )
+        require(
             self.decision_hz <= self.control_hz,
             "game.decision_hz",
             f"a rate no higher than game.control_hz ({self.control_hz} Hz)",
             self.decision_hz,
         )
+        ratio = self.control_hz / self.decision_hz
+        whole = ", ".join(f"{self.control_hz / k:.6g}" for k in range(1, 7))
+        require(
+            abs(ratio - round(ratio)) <= 1e-6 * ratio,
+            "game.decision_hz",
+            f"a rate that divides game.control_hz={self.control_hz:g} into whole ticks, "
+            f"control_hz / k for a whole k: {whole}, ... Hz",
+            self.decision_hz,
+        )
+
+    @property
+    def ticks(self) -> int:
+        """Control ticks in one game: ``t_max * control_hz``, rounded."""
+        return int(round(self.t_max * self.control_hz))
 
 
 @dataclass
@@ -70,20 +93,36 @@ def _schema_of(frozen: type) -> type:
     )
 
 
-@dataclass
-class Schema:
-    """The whole run config; plugin nodes are typed by their plugin's Config later."""
+#: The whole run config: the fixed nodes, one node per plugin kind of
+#: :data:`pegame.api.PLUGIN_KINDS` (typed by its plugin's Config when a game is built), and
+#: ``resume`` (skip games already stored in the job's results.jsonl).
+Schema = make_dataclass("Schema", [
+    ("game", GameConfig, field(default_factory=GameConfig)),
+    ("camera", Any, field(default_factory=_schema_of(Camera))),
+    ("env", EnvConfig, field(default_factory=EnvConfig)),
+    *[(kind, Any, field(default=MISSING)) for kind in PLUGIN_KINDS],
+    ("resume", bool, field(default=False)),
+])
 
-    game: GameConfig = field(default_factory=GameConfig)
-    camera: Any = field(default_factory=_schema_of(Camera))
-    env: EnvConfig = field(default_factory=EnvConfig)
-    sim: Any = MISSING
-    detector: Any = MISSING
-    estimator: Any = MISSING
-    pursuer: Any = MISSING
-    evader: Any = MISSING
-    recorder: Any = MISSING
-    resume: bool = False  # skip games already stored in the job's results.jsonl
+
+def check_known_keys(cfg: Mapping[str, Any]) -> None:
+    """ConfigError for a top-level key that is not pegame's (``+foo=1``, ``+gmae.t_max=5``):
+    Hydra's ``+`` adds keys past the schema, and a misspelt key would be ignored silently.
+    Keys inside game, camera and env are checked by :func:`typed`, plugin nodes by their
+    plugin's Config."""
+    allowed = [f.name for f in fields(Schema)]
+    for key in cfg:
+        if key not in allowed and key != "hydra":
+            raise ConfigError(
+                f"Unknown key '{key}'.{did_you_mean(str(key), allowed)} Allowed top-level "
+                f"keys: {', '.join(allowed)}."
+            )
+
+
+def did_you_mean(word: str, choices: Sequence[str]) -> str:
+    """`` Did you mean 'x'?`` for the closest of ``choices`` to ``word``, else ''."""
+    close = difflib.get_close_matches(word, list(choices), n=1)
+    return f" Did you mean '{close[0]}'?" if close else ""
 
 
 class PluginConfigSearchPath(SearchPathPlugin):
@@ -128,7 +167,9 @@ def typed(node: Mapping[str, Any], schema: type, key: str) -> Any:
     unknown = sorted(set(params) - set(allowed))
     if unknown:
         raise ConfigError(
-            f"Unknown key '{key}.{unknown[0]}'. Allowed keys under '{key}': {', '.join(allowed)}."
+            f"Unknown key '{key}.{unknown[0]}'."
+            f"{did_you_mean(f'{key}.{unknown[0]}', [f'{key}.{name}' for name in allowed])} "
+            f"Allowed keys under '{key}': {', '.join(allowed)}."
         )
     try:
         return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(schema), params))

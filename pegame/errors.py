@@ -19,6 +19,19 @@ class SpawnError(PegameError, RuntimeError):
     """No valid pair of start poses exists on the map for the configured agents."""
 
 
+class ResultsWriteError(PegameError, OSError):
+    """A result file could not be written (a full disk, a read-only directory)."""
+
+
+class JobDirectoryError(PegameError, RuntimeError):
+    """A job directory belongs to another job: it holds another config's games, or
+    another process writes to it. Nothing is written to it."""
+
+
+class PluginChoiceError(PegameError, LookupError):
+    """A plugin group on the command line names an option that does not exist."""
+
+
 def require(ok: bool, key: str, allowed: str, value: Any) -> None:
     """Raise ConfigError naming ``key``, its ``value`` and the ``allowed`` range unless ok."""
     if not ok:

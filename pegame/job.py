@@ -1,12 +1,22 @@
 """One Hydra job: ``game.trials`` games with seeds ``game.seed + i`` in one output dir.
 
 Each finished game appends one JSON line ``{"kind": "game", ...result}`` to the job's
-``results.jsonl`` and flushes it at once; a game that raises appends ``{"kind":
-"failed", ...}`` with its traceback in ``failed_<seed>.txt`` and the job goes on; the job's
-``{"kind": "summary", ...}`` line comes last. With ``resume=true`` games already stored
-are skipped. A job of one game also writes ``result.json`` (last, atomically),
-``trajectory.csv`` and ``trajectory.png``; recordings are ``game.rrd``, or
-``game_<seed>.rrd`` when the job plays several games.
+``results.jsonl`` and flushes it at once; a game that raises (a SpawnError for its seed, a
+plugin failing mid-game) appends ``{"kind": "failed", ...}`` naming the seed and the
+cause, with its traceback in ``failed_<seed>.txt``, and the job goes on; the job's
+``{"kind": "summary", ...}`` line comes last. Game and failed lines carry the job's
+``config`` (without seed, trials, resume and hydra), its ``config_hash``, the
+command-line ``overrides`` and the ``provenance`` of the software
+(:mod:`pegame.provenance`).
+
+Everything that does not depend on the seed is checked before the first game (the whole
+config, the map, every plugin and its options): a bad value is a
+:class:`~pegame.errors.PegameError` and nothing is played. The job holds the directory's
+lock (:mod:`pegame.joblock`) while it runs. With ``resume=true`` a game is skipped when a
+game with the same config hash and seed is stored; a directory holding games of another
+config is an error naming the keys that differ. A job of one game also writes
+``result.json`` (last, atomically), ``trajectory.csv`` and ``trajectory.png``;
+recordings are ``game.rrd``, or ``game_<seed>.rrd`` when the job plays several games.
 """
 
 from __future__ import annotations
@@ -17,45 +27,96 @@ import os
 import sys
 import time
 import traceback
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Iterator, Sequence
 
 from omegaconf import DictConfig, OmegaConf
 
-from pegame.config import GameConfig, typed
-from pegame.errors import PegameError
+from pegame import sweep
+from pegame.config import GameConfig, check_known_keys, typed
+from pegame.errors import JobDirectoryError, PegameError, ResultsWriteError, SpawnError
 from pegame.files import write_atomic
 from pegame.game import Game, Outcome, pairing, summary_line, write_outcome
+from pegame.joblock import JobLock
+from pegame.kernel_cache import announce_compilation
+from pegame.provenance import config_hash, differing_keys, job_config, provenance
 
 log = logging.getLogger("pegame")
 
 RESULTS = "results.jsonl"
 
 
-def stored_seeds(path: Path) -> set[int]:
-    """Seeds of the games already in ``path`` (a results.jsonl); truncated lines skipped."""
-    seeds = set()
-    if path.exists():
+@dataclass
+class JobRun:
+    """What one call of :func:`run_job` did: the results of the games it played and the
+    seeds of the games that failed."""
+
+    played: list[dict[str, Any]] = field(default_factory=list)
+    failed: list[int] = field(default_factory=list)
+
+    @property
+    def status(self) -> int:
+        """The job's exit status: 0 every game finished, 1 some failed."""
+        return sweep.GAMES_FAILED if self.failed else sweep.OK
+
+
+def read_lines(path: Path) -> Iterator[dict[str, Any]]:
+    """The entries of a results.jsonl; lines truncated by a killed job are skipped (and
+    anything but a regular file holds none)."""
+    if path.is_file():
         for line in path.read_text().splitlines():
             try:
-                entry = json.loads(line)
+                yield json.loads(line)
             except json.JSONDecodeError:
                 continue
-            if entry.get("kind") == "game":
-                seeds.add(int(entry["seed"]))
+
+
+def stored_seeds(path: Path, config: dict[str, Any]) -> set[int]:
+    """Seeds of the games of ``config`` already stored in ``path`` (a results.jsonl).
+
+    Raises JobDirectoryError naming the differing keys when ``path`` holds games or failed
+    games of another config: one job directory holds one config's games."""
+    digest, seeds = config_hash(config), set()
+    for entry in read_lines(path):
+        if entry.get("kind") not in ("game", "failed"):
+            continue
+        if entry.get("config_hash") != digest:
+            other = entry.get("config")
+            keys = differing_keys(other, config) if isinstance(other, dict) else ["(unrecorded config)"]
+            raise JobDirectoryError(
+                f"{path} holds games of another config (seed {entry.get('seed')}); this job "
+                f"differs in: {', '.join(keys)}. One job directory holds one config's games: "
+                f"choose another output directory (hydra.run.dir or hydra.sweep.dir) or move "
+                f"the old results away."
+            )
+        if entry["kind"] == "game":
+            seeds.add(int(entry["seed"]))
     return seeds
 
 
 def append_line(path: Path, entry: dict[str, Any]) -> None:
     """Append one JSON line and flush it (append-only: earlier lines stay intact). After a
-    job killed mid-line, the fragment is closed first so the new line stays readable."""
-    with path.open("ab+") as handle:
-        if handle.seek(0, os.SEEK_END) > 0:
-            handle.seek(-1, os.SEEK_END)
-            if handle.read(1) != b"\n":
-                handle.write(b"\n")
-        handle.write(json.dumps(entry).encode() + b"\n")
-        handle.flush()
+    job killed mid-line, the fragment is closed first so the new line stays readable.
+
+    A write that fails (a full disk) raises ResultsWriteError naming the file; the line
+    is printed in full on stderr first, so a finished game's result can be recovered."""
+    line = json.dumps(entry).encode() + b"\n"
+    try:
+        with path.open("ab+") as handle:
+            if handle.seek(0, os.SEEK_END) > 0:
+                handle.seek(-1, os.SEEK_END)
+                if handle.read(1) != b"\n":
+                    handle.write(b"\n")
+            handle.write(line)
+            handle.flush()
+    except OSError as exc:
+        print(f"pegame: this line could not be written to {path}:\n{line.decode()}", file=sys.stderr, end="")
+        raise ResultsWriteError(
+            f"Could not write to {path}: {exc.strerror or exc}. The unwritten line is printed "
+            f"above on stderr; free space or choose another output directory, then run again "
+            f"with resume=true."
+        ) from None
 
 
 def with_seed(cfg: DictConfig, seed: int) -> DictConfig:
@@ -74,55 +135,131 @@ def progress(seeds: list[int]) -> Iterator[int]:
     return iter(tqdm(seeds, desc="games", unit="game"))
 
 
-def run_job(cfg: DictConfig, out_dir: str | Path, base_dir: str | Path | None = None) -> list[dict]:
-    """Play the job's games into ``out_dir``; return the results of the games played now."""
+def run_job(
+    cfg: DictConfig,
+    out_dir: str | Path,
+    base_dir: str | Path | None = None,
+    overrides: Sequence[str] = (),
+) -> JobRun:
+    """Play the job's games into ``out_dir``, holding its lock; ``overrides`` are the
+    command-line overrides recorded with every game. PegameError before the first game
+    for a config that cannot be played at all."""
     out_dir = Path(out_dir)
-    settings = typed(cfg.game, GameConfig, "game")
+    with JobLock(out_dir):
+        return _run_locked(cfg, out_dir, base_dir, list(overrides))
+
+
+def _run_locked(
+    cfg: DictConfig, out_dir: Path, base_dir: str | Path | None, overrides: list[str]
+) -> JobRun:
+    settings, first = checked_first_game(cfg, base_dir)
+    config = job_config(cfg)
     results_path = out_dir / RESULTS
-    done = stored_seeds(results_path) if cfg.get("resume", False) else set()
+    stored = stored_seeds(results_path, config)
+    done = stored if cfg.get("resume", False) else set()
     seeds = [s for s in range(settings.seed, settings.seed + settings.trials) if s not in done]
     if done:
         log.info("resume: %d of %d games already stored", settings.trials - len(seeds), settings.trials)
-    single = settings.trials == 1
-    results, failed = [], 0
+    identity = {"config": config, "config_hash": config_hash(config), "overrides": overrides,
+                "provenance": provenance()}
+    single, parent, run = settings.trials == 1, sweep.sweep_parent(), JobRun()
     for seed in progress(seeds):
+        if sweep.orphaned(parent):
+            stop_orphaned(len(run.played))
         started = time.perf_counter()
         try:
-            game = Game(with_seed(cfg, seed), base_dir=base_dir)
+            game = first if seed == settings.seed else Game(with_seed(cfg, seed), base_dir=base_dir)
             outcome = game.play(out_dir, "game" if single else f"game_{seed}")
-        except PegameError:
-            raise  # a bad config or map fails every game alike: stop and say why
-        except Exception as exc:  # noqa: BLE001 - a failing game must not stop the sweep
-            failed += 1
-            record_failure(out_dir, seed, cfg, exc)
+        except Exception as exc:  # noqa: BLE001 - a failing game must not stop the job
+            run.failed.append(seed)
+            record_failure(out_dir, seed, cfg, exc, identity)
             continue
         log.info("seed %d played in %.2f s wall time", seed, time.perf_counter() - started)
-        append_line(results_path, {"kind": "game", **outcome.result})
-        results.append(outcome.result)
+        append_line(results_path, {"kind": "game", **outcome.result, **identity})
+        run.played.append(outcome.result)
         if single:
             write_single(outcome, game, out_dir)
         print(summary_line(outcome.result))
-    rates = [r["tracking_rate"] for r in results]
+    rates = [r["tracking_rate"] for r in run.played]
     append_line(results_path, {
         "kind": "summary",
-        "games": len(results),
-        "failed": failed,
+        "games": len(run.played),
+        "failed": len(run.failed),
         "tracking_rate_mean": round(sum(rates) / len(rates), 6) if rates else None,
+        "status": run.status,
     })
-    return results
+    return run
+
+
+def checked_first_game(cfg: DictConfig, base_dir: str | Path | None) -> tuple[GameConfig, Game]:
+    """The game settings and the job's first game, built: building it checks everything
+    that does not depend on the seed (every key, the map, every plugin and its options),
+    so a bad value fails here, before any game is played."""
+    check_known_keys(cfg)
+    settings = typed(cfg.game, GameConfig, "game")
+    announce_compilation()
+    first = Game(with_seed(cfg, settings.seed), base_dir=base_dir)
+    check_room_to_spawn(first)
+    return settings, first
+
+
+def check_room_to_spawn(game: Game) -> None:
+    """SpawnError before the first game when the map has no free pose at all for the
+    pursuer or the evader: then no seed can spawn them (a seed that finds no valid pair
+    where poses exist is that game's failure, recorded like any other)."""
+    from pegame.navigation import Planner
+
+    context = game.context
+    for role, body in (("pursuer", context.pursuer), ("evader", context.evader)):
+        if not Planner.shared(context.grid, body.radius).traversable.any():
+            raise SpawnError(
+                f"No valid spawn on map '{context.grid.name}': no cell is free for the {role} "
+                f"(radius {body.radius} m). Use a map with more free space or a smaller "
+                f"{role}.radius."
+            )
+
+
+def stop_orphaned(stored: int) -> None:
+    """Exit this worker process at once: the sweep's process died, so nothing would
+    collect its work and a resume may already be running. The games stored so far stay
+    (each line was flushed when its game finished); the lock goes with the process."""
+    log.warning("the sweep's process died: this worker stops after %d games played now; "
+                "run the sweep again with resume=true to complete it", stored)
+    logging.shutdown()
+    os._exit(sweep.GAMES_FAILED)
+
+
+def write_invalid(out_dir: str | Path, error: PegameError, overrides: Sequence[str]) -> None:
+    """Record a multirun job whose config cannot be played: one ``invalid`` line, so the
+    sweep report shows the cell as failed and the other cells still run."""
+    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    append_line(Path(out_dir) / RESULTS, {
+        "kind": "invalid",
+        "error": " ".join(str(error).split()),
+        "overrides": list(overrides),
+    })
 
 
 def write_single(outcome: Outcome, game: Game, out_dir: Path) -> None:
     """A one-game job's files: trajectory.png, trajectory.csv, then result.json."""
     from pegame.figures import plot_trajectory
 
-    plot_trajectory(game.context.grid, outcome.trajectory, out_dir / "trajectory.png",
-                    title=summary_line(outcome.result))
-    write_outcome(outcome, out_dir)
+    try:
+        plot_trajectory(game.context.grid, outcome.trajectory, out_dir / "trajectory.png",
+                        title=summary_line(outcome.result))
+        write_outcome(outcome, out_dir)
+    except OSError as exc:
+        raise ResultsWriteError(
+            f"Could not write the game's files in {out_dir}: {exc}. Its result is stored in "
+            f"{out_dir / RESULTS}."
+        ) from None
 
 
-def record_failure(out_dir: Path, seed: int, cfg: DictConfig, exc: Exception) -> None:
-    """Log a failed game, keep its traceback, and append a 'failed' line."""
+def record_failure(
+    out_dir: Path, seed: int, cfg: DictConfig, exc: Exception, identity: dict[str, Any]
+) -> None:
+    """Log a failed game, keep its traceback, and append a 'failed' line naming the seed
+    and the cause."""
     text = "".join(traceback.format_exception(exc))
     write_atomic(out_dir / f"failed_{seed}.txt", text)
     log.error("seed %d failed: %s (traceback in failed_%d.txt)", seed, exc, seed)
@@ -134,4 +271,5 @@ def record_failure(out_dir: Path, seed: int, cfg: DictConfig, exc: Exception) ->
         "speed_ratio": float(cfg.game.speed_ratio),
         "error": f"{type(exc).__name__}: {exc}".splitlines()[0],
         "traceback_file": f"failed_{seed}.txt",
+        **identity,
     })

@@ -10,22 +10,17 @@ points (in pegame's own pyproject.toml) as third-party ones.
 from __future__ import annotations
 
 import difflib
+import itertools
+import warnings
 from functools import lru_cache
 from importlib.metadata import EntryPoint, entry_points
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping
 
-
+from pegame.api import INTERFACES, PLUGIN_KINDS
 from pegame.errors import PegameError
 
-#: config group -> entry-point group
-GROUPS: dict[str, str] = {
-    "sim": "pegame.simulators",
-    "detector": "pegame.detectors",
-    "estimator": "pegame.estimators",
-    "pursuer": "pegame.pursuers",
-    "evader": "pegame.evaders",
-    "recorder": "pegame.recorders",
-}
+#: config group -> entry-point group, derived from :data:`pegame.api.PLUGIN_KINDS`
+GROUPS: dict[str, str] = {kind: spec.entry_point_group for kind, spec in PLUGIN_KINDS.items()}
 
 
 class PluginError(PegameError, LookupError):
@@ -41,10 +36,37 @@ def _entry_point_group(group: str) -> str:
         ) from None
 
 
+def unique_by_name(points: Iterable[EntryPoint]) -> dict[str, EntryPoint]:
+    """One entry point per name, sorted by name. When several distributions register the
+    same name, warn naming them and keep the first in distribution-name order, so which
+    plugin wins does not depend on the order of sys.path (the pattern of xarray's
+    ``backends/plugins.py``)."""
+    ranked = sorted(points, key=lambda ep: (ep.name, distribution_of(ep), ep.value))
+    unique = {}
+    for name, same in itertools.groupby(ranked, key=lambda ep: ep.name):
+        same = list(same)
+        if len(same) > 1:
+            who = ", ".join(f"{distribution_of(ep)} ({ep.value})" for ep in same)
+            warnings.warn(
+                f"{len(same)} distributions register the plugin name '{name}' under "
+                f"'{same[0].group}': {who}. Using the one from '{distribution_of(same[0])}'; "
+                f"uninstall or rename the others.",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+        unique[name] = same[0]
+    return unique
+
+
 @lru_cache(maxsize=None)
 def _entry_points(group: str) -> dict[str, EntryPoint]:
-    found = entry_points(group=_entry_point_group(group))
-    return {ep.name: ep for ep in sorted(found, key=lambda ep: ep.name)}
+    return unique_by_name(entry_points(group=_entry_point_group(group)))
+
+
+def refresh() -> None:
+    """Discover the entry points again (after installing or removing a plugin
+    distribution in a running session, e.g. a notebook)."""
+    _entry_points.cache_clear()
 
 
 def available(group: str) -> list[str]:
@@ -73,8 +95,6 @@ def distribution_of(point: EntryPoint) -> str:
 
 def load(group: str, name: str) -> type:
     """Import and return the plugin class ``name`` of ``group``, checking its interface."""
-    from pegame.api import INTERFACES  # the interfaces are light; plugins are not
-
     point = entry_point(group, name)
     try:
         cls = point.load()
@@ -90,19 +110,27 @@ def load(group: str, name: str) -> type:
             f"The {group} plugin '{name}' (distribution '{distribution_of(point)}', "
             f"{point.value}) failed to import: {exc}.{hint}"
         ) from exc
+    check_interface(group, name, point, cls)
+    return cls
+
+
+def check_interface(group: str, name: str, point: EntryPoint, cls: Any) -> None:
+    """PluginError unless ``cls`` is a concrete subclass of the group's interface; the
+    message names the plugin, its distribution and the methods it does not implement."""
     interface = INTERFACES[group]
+    where = f"The {group} plugin '{name}' (distribution '{distribution_of(point)}', {point.value})"
     if not (isinstance(cls, type) and issubclass(cls, interface)):
-        raise TypeError(
-            f"The {group} plugin '{name}' ({point.value}) must be a subclass of "
-            f"pegame.api.{interface.__name__}, got {cls!r}."
+        raise PluginError(
+            f"{where} must be a subclass of pegame.api.{interface.__name__}, got {cls!r}. "
+            f"Derive it from pegame.api.{interface.__name__} and implement "
+            f"{', '.join(sorted(interface.__abstractmethods__))}."
         )
     abstract = sorted(getattr(cls, "__abstractmethods__", ()))
     if abstract:
-        raise TypeError(
-            f"The {group} plugin '{name}' ({point.value}) does not implement "
-            f"{interface.__name__}: missing {', '.join(abstract)}."
+        raise PluginError(
+            f"{where} does not implement pegame.api.{interface.__name__}: missing "
+            f"{', '.join(abstract)}."
         )
-    return cls
 
 
 def make_config(group: str, cls: type, params: Mapping[str, Any]) -> Any:
@@ -119,7 +147,7 @@ def describe(group: str) -> list[tuple[str, str, str]]:
     for name, point in _entry_points(group).items():
         try:
             text = next(iter((load(group, name).description or "").strip().splitlines()), "")
-        except (PluginError, TypeError) as exc:
+        except PluginError as exc:
             text = f"(broken: {exc})"
         rows.append((name, distribution_of(point), text))
     return rows

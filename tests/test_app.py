@@ -18,10 +18,13 @@ FAST = ["game.t_max=8", "recorder=none"]
 
 
 def run_app(tmp_path: Path, *overrides: str, name: str = "run") -> subprocess.CompletedProcess:
-    """Run ``python -m pegame`` from an unrelated directory into ``tmp_path / name``."""
+    """Run ``python -m pegame`` from an unrelated directory into ``tmp_path / name`` (a
+    ``-m`` among the overrides makes it a multirun)."""
     env = {k: v for k, v in os.environ.items() if k != "HYDRA_FULL_ERROR"}
+    flags = [o for o in overrides if o == "-m"]
+    overrides = tuple(o for o in overrides if o != "-m")
     return subprocess.run(
-        [sys.executable, "-m", "pegame", f"hydra.run.dir={tmp_path / name}", *overrides],
+        [sys.executable, "-m", "pegame", *flags, f"hydra.run.dir={tmp_path / name}", *overrides],
         cwd=tmp_path, capture_output=True, text=True, env=env, timeout=300,
     )
 
@@ -64,8 +67,17 @@ def test_any_ros_map_by_absolute_path(tmp_path):
 @pytest.mark.parametrize(
     "overrides, expected",
     [
-        (["pursuer=smrt"], "Available options in 'pursuer'"),
+        (["pursuer=smrt"], "Unknown pursuer 'smrt'. Did you mean 'smart'?"),
+        (["-m", "evader=smart,smrat"], "Unknown evader 'smrat'. Did you mean 'smart'?"),
+        (["+foo=1"], "Unknown key 'foo'"),
+        (["+gmae.t_max=5"], "Unknown key 'gmae'. Did you mean 'game'?"),
+        (["+camera.bar=2"], "Unknown key 'camera.bar'"),
+        (["game.seed=-1"], "game.seed"),
+        (["game.t_max=0.01"], "at least one control tick"),
+        (["game.decision_hz=3"], "10, 5, 3.33333, 2.5, 2"),
         (["game.t_maxx=3"], "game.t_maxx"),
+        (["-m", "game.t_max=5,abc"], "game.t_max"),
+        (["game.t_max=[1"], "override_grammar"),
         (["game.t_max=abc"], "game.t_max"),
         (["evader.v_max=0"], "evader.v_max"),
         (["game.control_hz=-10"], "game.control_hz"),
@@ -76,10 +88,11 @@ def test_any_ros_map_by_absolute_path(tmp_path):
 )
 def test_bad_input_is_one_clear_error_without_traceback_or_result(tmp_path, overrides, expected):
     proc = run_app(tmp_path, *FAST, *overrides)
-    assert proc.returncode != 0
+    assert proc.returncode == 2
     assert expected in proc.stderr
     assert "Traceback" not in proc.stderr
     assert not (tmp_path / "run" / "result.json").exists()
+    assert not (tmp_path / "run" / "results.jsonl").exists()  # failed before the first game
 
 
 def test_a_map_with_no_valid_spawn_is_reported(tmp_path):
@@ -90,3 +103,99 @@ def test_a_map_with_no_valid_spawn_is_reported(tmp_path):
     assert proc.returncode == 2
     assert "No valid spawn" in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "run" / "result.json").exists()
+
+
+def lines(path: Path) -> list[dict]:
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+def test_a_game_that_fails_exits_1_and_the_others_are_written(tmp_path):
+    # a 1e-5 rad camera finds a spawn for seeds 0-5 but not for seed 6
+    proc = run_app(tmp_path, *FAST, "env=enclosed", "camera.fov=1e-5", "game.seed=5", "game.trials=3")
+    assert proc.returncode == 1, proc.stderr
+    kinds = [(e["kind"], e.get("seed")) for e in lines(tmp_path / "run" / "results.jsonl")]
+    assert kinds == [("game", 5), ("failed", 6), ("game", 7), ("summary", None)]
+    assert "seed 6 failed: No valid spawn" in proc.stdout  # Hydra logs to stdout
+
+
+@pytest.mark.parametrize("launcher", ["joblib", "basic"])
+def test_a_sweep_whose_games_all_fail_exits_1(tmp_path, launcher):
+    proc = run_app(tmp_path, "-m", *FAST, "env=enclosed", "camera.fov=1e-5", "game.seed=6",
+                   "pursuer=random", "evader=random,smart", f"hydra/launcher={launcher}",
+                   f"hydra.sweep.dir={tmp_path / 'sweep'}")
+    assert proc.returncode == 1, proc.stderr
+    for path in sorted((tmp_path / "sweep").glob("*/results.jsonl")):
+        assert [e["kind"] for e in lines(path)] == ["failed", "summary"]
+
+
+def test_one_bad_cell_of_a_sweep_is_reported_and_the_others_run(tmp_path):
+    proc = run_app(tmp_path, "-m", *FAST, "env=hall", "game.speed_ratio=0,1",
+                   f"hydra.sweep.dir={tmp_path / 'sweep'}")
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr
+    bad, good = (lines(tmp_path / "sweep" / cell / "results.jsonl") for cell in ("0", "1"))
+    assert bad == [{"kind": "invalid", "error": bad[0]["error"],
+                    "overrides": [*FAST, "env=hall", "game.speed_ratio=0"]}]
+    assert "'game.speed_ratio'" in bad[0]["error"]
+    assert [e["kind"] for e in good] == ["game", "summary"]
+    assert (tmp_path / "sweep" / "table1.md").exists()  # the report ran
+
+
+def test_overrides_are_recorded_with_every_game(tmp_path):
+    proc = run_app(tmp_path, *FAST, "env=hall", "pursuer=random")
+    assert proc.returncode == 0, proc.stderr
+    entry = lines(tmp_path / "run" / "results.jsonl")[0]
+    assert entry["overrides"] == [*FAST, "env=hall", "pursuer=random"]
+    assert entry["config"]["pursuer"]["name"] == "random"
+
+
+def test_resuming_a_sweep_with_other_cells_is_an_error_naming_the_keys(tmp_path):
+    sweep = f"hydra.sweep.dir={tmp_path / 'sweep'}"
+    first = run_app(tmp_path, "-m", *FAST, "pursuer=random", "evader=random", "game.trials=2",
+                    "env=enclosed,brick", sweep)
+    assert first.returncode == 0, first.stderr
+    before = {p: p.read_bytes() for p in (tmp_path / "sweep").glob("*/results.jsonl")}
+    again = run_app(tmp_path, "-m", *FAST, "pursuer=random", "evader=random", "game.trials=2",
+                    "env=brick,hall", "resume=true", sweep)
+    assert again.returncode == 2
+    assert "holds games of another config" in again.stderr and "env.name" in again.stderr
+    assert {p: p.read_bytes() for p in (tmp_path / "sweep").glob("*/results.jsonl")} == before
+
+
+def test_a_job_directory_has_one_writer(tmp_path):
+    from pegame.joblock import JobLock
+
+    with JobLock(tmp_path / "run"):
+        proc = run_app(tmp_path, *FAST)
+    assert proc.returncode == 2
+    assert "Another pegame process" in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "run" / "results.jsonl").exists()
+
+
+def test_a_full_disk_is_one_clear_error_and_the_result_is_printed(tmp_path):
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "results.jsonl").symlink_to("/dev/full")
+    proc = run_app(tmp_path, *FAST, "env=hall")
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert f"Could not write to {tmp_path / 'run' / 'results.jsonl'}: No space left" in proc.stderr
+    printed = [line for line in proc.stderr.splitlines() if line.startswith('{"kind": "game"')]
+    assert json.loads(printed[0])["map"] == "hall"
+
+
+def test_the_first_run_says_once_that_it_compiles_the_kernels(tmp_path, monkeypatch, caplog):
+    from pegame import job, kernel_cache
+    from pegame.config import compose
+
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    job.run_job(compose([*FAST, "env=hall"]), tmp_path / "warm")
+    assert not kernel_cache.cache_is_cold()  # numba wrote its cache where pegame looks
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))  # an empty cache: a new install
+    assert kernel_cache.cache_is_cold()
+    kernel_cache.announce_compilation.cache_clear()
+    with caplog.at_level("INFO", logger="pegame"):
+        assert kernel_cache.announce_compilation()
+        kernel_cache.announce_compilation()
+    said = [r.message for r in caplog.records if "compiling pegame's numba kernels" in r.message]
+    assert len(said) == 1 and "half a minute" in said[0]
+    kernel_cache.announce_compilation.cache_clear()

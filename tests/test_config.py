@@ -10,7 +10,8 @@ from omegaconf import OmegaConf
 
 from pegame import registry
 from pegame.types import Camera
-from pegame.config import EnvConfig, GameConfig, resolve_map_path, typed
+from pegame.api import PLUGIN_KINDS
+from pegame.config import EnvConfig, GameConfig, Schema, check_known_keys, resolve_map_path, typed
 from pegame.errors import ConfigError
 from pegame.grid import load_map
 
@@ -56,7 +57,13 @@ def test_default_config_validates(compose_config):
         ("game", GameConfig, {"speed_ratio": -2.0}, "'game.speed_ratio'"),
         ("game", GameConfig, {"decision_hz": 20.0}, "'game.decision_hz'"),
         ("game", GameConfig, {"t_max": "abc"}, "'game.t_max'"),
-        ("game", GameConfig, {"t_maxx": 3}, "Unknown key 'game.t_maxx'. Allowed keys under 'game': seed, t_max"),
+        ("game", GameConfig, {"t_maxx": 3}, "Unknown key 'game.t_maxx'. Did you mean 'game.t_max'?"),
+        ("game", GameConfig, {"t_maxx": 3}, "Allowed keys under 'game': seed, t_max"),
+        ("game", GameConfig, {"seed": -1}, "'game.seed': -1"),
+        ("game", GameConfig, {"t_max": 0.01}, "at least one control tick, 0.1 s"),
+        ("game", GameConfig, {"decision_hz": 3.0}, "divides game.control_hz=10 into whole ticks"),
+        ("game", GameConfig, {"decision_hz": 3.0}, "10, 5, 3.33333, 2.5, 2, 1.66667"),
+        ("game", GameConfig, {"control_hz": 30.0, "decision_hz": 4.0}, "30, 15, 10, 7.5, 6, 5"),
         ("camera", Camera, {"fov": 7.0}, "'camera.fov'"),
         ("camera", Camera, {"fov": 0.0}, "(0, 2*pi]"),
         ("camera", Camera, {"far": 0.1}, "'camera.far'"),
@@ -82,3 +89,35 @@ def test_plugin_config_errors_name_the_key(group, option, params, key):
     cls = registry.load(group, option)
     with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
         registry.make_config(group, cls, params)
+
+
+@pytest.mark.parametrize("decision_hz", [10.0, 5.0, 2.5, 2.0, 1.0, 0.5, 10 / 3])
+def test_decision_rates_that_divide_into_whole_ticks_are_accepted(decision_hz):
+    settings = GameConfig(control_hz=10.0, decision_hz=decision_hz)
+    assert settings.control_hz / settings.decision_hz == pytest.approx(round(10.0 / decision_hz))
+
+
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        (["+foo=1"], "Unknown key 'foo'. Allowed top-level keys: game, camera, env, sim"),
+        (["+gmae.t_max=5"], "Unknown key 'gmae'. Did you mean 'game'?"),
+        (["+rsume=true"], "Did you mean 'resume'?"),
+    ],
+)
+def test_unknown_top_level_keys_are_rejected(compose_config, overrides, message):
+    with pytest.raises(ConfigError) as info:
+        check_known_keys(compose_config(overrides))
+    assert message in str(info.value)
+
+
+def test_the_default_config_has_only_known_keys(compose_config):
+    check_known_keys(compose_config())
+
+
+def test_the_schema_has_one_node_per_plugin_kind():
+    from dataclasses import fields
+
+    names = [f.name for f in fields(Schema)]
+    assert [n for n in names if n in PLUGIN_KINDS] == list(PLUGIN_KINDS)
+    assert set(names) - set(PLUGIN_KINDS) == {"game", "camera", "env", "resume"}

@@ -9,7 +9,7 @@ from importlib.metadata import EntryPoint
 import pytest
 
 from pegame import registry
-from pegame.api import INTERFACES
+from pegame.api import INTERFACES, PLUGIN_KINDS
 
 
 @pytest.fixture
@@ -58,12 +58,51 @@ def test_import_failure_names_plugin_distribution_and_install_hint(fake_points):
     assert "pip install pegame_missing_dependency_xyz" in text
 
 
-def test_class_that_is_not_the_interface_is_a_type_error(fake_points):
+def test_class_that_is_not_the_interface_is_a_plugin_error_naming_the_methods(fake_points):
     fake_points(alien="fake_plugins:NotAPlugin", half="fake_plugins:HalfPursuer")
-    with pytest.raises(TypeError, match="must be a subclass of pegame.api.Pursuer"):
+    with pytest.raises(registry.PluginError, match="must be a subclass of pegame.api.Pursuer"):
         registry.load("pursuer", "alien")
-    with pytest.raises(TypeError, match="missing control, decide"):
+    with pytest.raises(registry.PluginError) as info:
         registry.load("pursuer", "half")
+    assert "does not implement pegame.api.Pursuer: missing control, decide" in str(info.value)
+    assert "pursuer plugin 'half'" in str(info.value) and "fake_plugins:HalfPursuer" in str(info.value)
+
+
+class FakeDistribution:
+    def __init__(self, name):
+        self.name = name
+
+
+def point(name, value, dist):
+    """An entry point of ``pegame.pursuers`` provided by the distribution ``dist``."""
+    return EntryPoint(name, value, "pegame.pursuers")._for(FakeDistribution(dist))
+
+
+def test_two_distributions_registering_one_name_warn_and_the_choice_is_stable():
+    points = [point("smart", "b_pkg:Smart", "pegame-b"), point("smart", "a_pkg:Smart", "pegame-a"),
+              point("random", "pegame.pursuers.random:RandomPursuer", "pegame")]
+    with pytest.warns(RuntimeWarning) as record:
+        unique = registry.unique_by_name(points)
+    assert list(unique) == ["random", "smart"]
+    assert unique["smart"].value == "a_pkg:Smart"
+    with pytest.warns(RuntimeWarning):
+        assert unique == registry.unique_by_name(reversed(points))  # independent of sys.path order
+    text = str(record[0].message)
+    assert "'smart'" in text and "pegame-a (a_pkg:Smart)" in text and "pegame-b (b_pkg:Smart)" in text
+
+
+def test_the_installed_plugins_have_no_duplicate_names(recwarn):
+    for group in registry.GROUPS:
+        registry.refresh()
+        registry.available(group)
+    assert not [w for w in recwarn if "register the plugin name" in str(w.message)]
+
+
+def test_groups_and_interfaces_come_from_the_one_list_of_plugin_kinds():
+    assert list(registry.GROUPS) == list(PLUGIN_KINDS) == list(INTERFACES)
+    for kind, spec in PLUGIN_KINDS.items():
+        assert registry.GROUPS[kind] == spec.entry_point_group
+        assert INTERFACES[kind] is spec.interface
 
 
 def test_import_pegame_loads_no_plugin():
@@ -78,7 +117,7 @@ def test_import_pegame_loads_no_plugin():
 
 def test_plugins_listing_shows_every_plugin_with_its_distribution():
     out = subprocess.run(
-        [sys.executable, "-m", "pegame.plugins"], capture_output=True, text=True, check=True
+        [sys.executable, "-m", "pegame.catalog"], capture_output=True, text=True, check=True
     ).stdout
     for group, ep_group in registry.GROUPS.items():
         assert f"{group} ({ep_group})" in out

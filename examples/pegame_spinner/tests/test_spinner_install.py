@@ -25,7 +25,7 @@ def fake_install(site: Path) -> dict[str, str]:
 def test_the_example_plugin_is_listed_and_plays(tmp_path):
     env = fake_install(tmp_path / "site")
     listing = subprocess.run(
-        [sys.executable, "-m", "pegame.plugins"],
+        [sys.executable, "-m", "pegame.catalog"],
         env=env,
         capture_output=True,
         text=True,

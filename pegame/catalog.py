@@ -1,4 +1,4 @@
-"""``python -m pegame.plugins``: every registered plugin per group, with the distribution
+"""``python -m pegame.catalog``: every registered plugin per group, with the distribution
 that provides it and its one-line description."""
 
 from __future__ import annotations
