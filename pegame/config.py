@@ -74,6 +74,11 @@ class GameConfig:
         """Control ticks in one game: ``t_max * control_hz``, rounded."""
         return int(round(self.t_max * self.control_hz))
 
+    @property
+    def decide_every(self) -> int:
+        """Control ticks per decision: ``control_hz / decision_hz``, a whole number."""
+        return max(1, int(round(self.control_hz / self.decision_hz)))
+
 
 @dataclass
 class EnvConfig:

@@ -142,8 +142,6 @@ class Scenario:
             decision_dt=1.0 / self.settings.decision_hz,
         )
         self.config = OmegaConf.to_container(cfg, resolve=True)
-        self.ticks = int(round(self.settings.t_max * self.settings.control_hz))
-        self.decide_every = max(1, int(round(self.settings.control_hz / self.settings.decision_hz)))
 
     def game(self, seed: int) -> Game:
         """The game of this scenario with master seed ``seed``."""
@@ -172,8 +170,9 @@ class Game:
 
     def start(self, external: tuple[str, ...] = (), estimate: bool = True) -> TickLoop:
         """Spawn both agents and return the game's tick loop at tick 0 (see TickLoop)."""
-        loop = TickLoop(self.plugins, self.context, self.scenario.ticks, self.scenario.decide_every,
-                        external, estimate)
+        settings = self.scenario.settings
+        loop = TickLoop(self.plugins, self.context, settings.ticks, settings.decide_every, external,
+                        estimate)
         loop.start(*spawn(self.context, self.spawn_rng))
         return loop
 
@@ -215,7 +214,7 @@ class Game:
             "t_max": s.t_max,
             "control_hz": s.control_hz,
             "decision_hz": s.decision_hz,
-            "ticks": self.scenario.ticks,
+            "ticks": s.ticks,
             **metrics.summary(),
         }
 

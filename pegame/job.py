@@ -31,13 +31,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from pegame import sweep
-from pegame.config import GameConfig, check_known_keys, typed
+from pegame.config import check_known_keys
 from pegame.errors import JobDirectoryError, PegameError, ResultsWriteError, SpawnError
 from pegame.files import write_atomic
-from pegame.game import Game, Outcome, pairing, summary_line, write_outcome
+from pegame.game import Game, Outcome, Scenario, pairing, summary_line, write_outcome
 from pegame.joblock import JobLock
 from pegame.kernel_cache import announce_compilation
 from pegame.provenance import config_hash, differing_keys, job_config, provenance
@@ -119,13 +119,6 @@ def append_line(path: Path, entry: dict[str, Any]) -> None:
         ) from None
 
 
-def with_seed(cfg: DictConfig, seed: int) -> DictConfig:
-    """A copy of ``cfg`` with ``game.seed`` set to ``seed``."""
-    copy = cfg.copy()
-    OmegaConf.update(copy, "game.seed", seed)
-    return copy
-
-
 def progress(seeds: list[int]) -> Iterator[int]:
     """Iterate ``seeds`` with a progress bar when stderr is a terminal."""
     if not sys.stderr.isatty() or len(seeds) < 2:
@@ -152,7 +145,8 @@ def run_job(
 def _run_locked(
     cfg: DictConfig, out_dir: Path, base_dir: str | Path | None, overrides: list[str]
 ) -> JobRun:
-    settings, first = checked_first_game(cfg, base_dir)
+    scenario = checked_scenario(cfg, base_dir)
+    settings = scenario.settings
     config = job_config(cfg)
     results_path = out_dir / RESULTS
     stored = stored_seeds(results_path, config)
@@ -168,7 +162,7 @@ def _run_locked(
             stop_orphaned(len(run.played))
         started = time.perf_counter()
         try:
-            game = first if seed == settings.seed else Game(with_seed(cfg, seed), base_dir=base_dir)
+            game = scenario.game(seed)
             outcome = game.play(out_dir, "game" if single else f"game_{seed}")
         except Exception as exc:  # noqa: BLE001 - a failing game must not stop the job
             run.failed.append(seed)
@@ -191,25 +185,24 @@ def _run_locked(
     return run
 
 
-def checked_first_game(cfg: DictConfig, base_dir: str | Path | None) -> tuple[GameConfig, Game]:
-    """The game settings and the job's first game, built: building it checks everything
-    that does not depend on the seed (every key, the map, every plugin and its options),
-    so a bad value fails here, before any game is played."""
+def checked_scenario(cfg: DictConfig, base_dir: str | Path | None) -> Scenario:
+    """The job's scenario, built once: building it checks everything that does not depend
+    on the seed (every key, the map, every plugin and its options), so a bad value fails
+    here, before any game is played."""
     check_known_keys(cfg)
-    settings = typed(cfg.game, GameConfig, "game")
     announce_compilation()
-    first = Game(with_seed(cfg, settings.seed), base_dir=base_dir)
-    check_room_to_spawn(first)
-    return settings, first
+    scenario = Scenario(cfg, base_dir)
+    check_room_to_spawn(scenario)
+    return scenario
 
 
-def check_room_to_spawn(game: Game) -> None:
+def check_room_to_spawn(scenario: Scenario) -> None:
     """SpawnError before the first game when the map has no free pose at all for the
     pursuer or the evader: then no seed can spawn them (a seed that finds no valid pair
     where poses exist is that game's failure, recorded like any other)."""
     from pegame.navigation import Planner
 
-    context = game.context
+    context = scenario.context
     for role, body in (("pursuer", context.pursuer), ("evader", context.evader)):
         if not Planner.shared(context.grid, body.radius).traversable.any():
             raise SpawnError(

@@ -127,7 +127,7 @@ def check_interface(kind: str, cls: type[Plugin], name: str | None = None) -> No
         isinstance(description, str)
         and description.strip() != ""
         and "\n" not in description.strip(),
-        f"{cls.__name__}.description must be a one-line summary (python -m pegame.plugins "
+        f"{cls.__name__}.description must be a one-line summary (python -m pegame.catalog "
         f"shows it), got {description!r}.",
     )
     config = cls.Config

@@ -64,7 +64,7 @@ class EnvGame:
     @property
     def steps(self) -> int:
         """Steps in one game."""
-        return -(-self.scenario.ticks // self.ticks_per_action)
+        return -(-self.scenario.settings.ticks // self.ticks_per_action)
 
     def reset(self, seed: int) -> dict[str, np.ndarray]:
         """Start a game with master seed ``seed``; the learners' first observations."""
