@@ -48,13 +48,21 @@ def evaluate(envs: list[gymnasium.Env], policy: LinearPolicy, seeds: list[int]) 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0, help="wall-time budget")
-    parser.add_argument("--generations", type=int, default=None, help="stop after this many (reproducible)")
+    parser.add_argument(
+        "--generations", type=int, default=None, help="stop after this many (reproducible)"
+    )
     parser.add_argument("--population", type=int, default=16, help="candidates per generation")
-    parser.add_argument("--elite", type=float, default=0.25, help="fraction of candidates refitted on")
+    parser.add_argument(
+        "--elite", type=float, default=0.25, help="fraction of candidates refitted on"
+    )
     parser.add_argument("--episodes", type=int, default=2, help="games per candidate and opponent")
     parser.add_argument("--t-max", type=float, default=30.0, help="game length in training (s)")
-    parser.add_argument("--opponents", default="random,smart", help="the evader strategies trained against")
-    parser.add_argument("--override", action="append", default=["env=enclosed"], help="an app override")
+    parser.add_argument(
+        "--opponents", default="random,smart", help="the evader strategies trained against"
+    )
+    parser.add_argument(
+        "--override", action="append", default=["env=enclosed"], help="an app override"
+    )
     parser.add_argument("--crop-cells", type=int, default=8)
     parser.add_argument("--crop-resolution", type=float, default=0.5)
     parser.add_argument("--seed", type=int, default=0)
@@ -64,8 +72,11 @@ def main() -> None:
     settings = ObservationSettings(args.crop_cells, args.crop_resolution)
     envs = [
         gymnasium.make(
-            "pegame/Pursuit-v0", overrides=[*args.override, f"game.t_max={args.t_max}"], opponent=opponent,
-            crop_cells=settings.crop_cells, crop_resolution=settings.crop_resolution,
+            "pegame/Pursuit-v0",
+            overrides=[*args.override, f"game.t_max={args.t_max}"],
+            opponent=opponent,
+            crop_cells=settings.crop_cells,
+            crop_resolution=settings.crop_resolution,
         )
         for opponent in args.opponents.split(",")
     ]
@@ -93,12 +104,17 @@ def main() -> None:
         # A small floor on the spread keeps the search from collapsing too early.
         mean, std = elite.mean(axis=0), elite.std(axis=0) + 0.02
         generation += 1
-        print(f"generation {generation}: best {scores.max():.3f}, mean {scores.mean():.3f}, "
-              f"elite mean {np.sort(scores)[-n_elite:].mean():.3f}", flush=True)
+        print(
+            f"generation {generation}: best {scores.max():.3f}, mean {scores.mean():.3f}, "
+            f"elite mean {np.sort(scores)[-n_elite:].mean():.3f}",
+            flush=True,
+        )
     policy_of(mean).save(args.out)
     held_out = evaluate(envs, policy_of(mean), list(range(1000, 1005)))
-    print(f"saved {args.out}: tracking rate {held_out:.3f} over 5 held-out {args.t_max:g} s games "
-          f"against each of the {args.opponents} evaders")
+    print(
+        f"saved {args.out}: tracking rate {held_out:.3f} over 5 held-out {args.t_max:g} s games "
+        f"against each of the {args.opponents} evaders"
+    )
 
 
 if __name__ == "__main__":

@@ -15,9 +15,9 @@ import logging
 import os
 import signal
 import sys
+from collections.abc import Sequence
 from importlib.metadata import entry_points
 from importlib.resources import files
-from typing import Sequence
 
 import hydra
 from hydra.core.hydra_config import HydraConfig
@@ -97,19 +97,25 @@ def check_plugin_choices(args: Sequence[str]) -> None:
     options only Hydra knows."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
-    if any(a.startswith(("--config-dir", "-cd", "--config-path", "-cp", "hydra.searchpath")) for a in args):
+    if any(
+        a.startswith(("--config-dir", "-cd", "--config-path", "-cp", "hydra.searchpath"))
+        for a in args
+    ):
         return
     candidates = [a for a in args if "=" in a and not a.startswith("-")]
     try:
         parsed = OverridesParser.create().parse_overrides(candidates)
-    except Exception:  # noqa: BLE001 - a malformed override is Hydra's to report
+    except Exception:
         return
     for override in parsed:
         kind = override.key_or_group
         if kind not in PLUGIN_KINDS or override.package or override.is_delete():
             continue
-        values = list(override.sweep_string_iterator()) if override.is_sweep_override() else [
-            override.get_value_element_as_str()]
+        values = (
+            list(override.sweep_string_iterator())
+            if override.is_sweep_override()
+            else [override.get_value_element_as_str()]
+        )
         options = plugin_options(kind)
         for value in values:
             if value not in options:
@@ -139,8 +145,10 @@ def main() -> None:
         print(f"pegame: error: {exc}", file=sys.stderr)  # before Hydra: no job log yet
         sys.exit(sweep.BAD_INPUT)
     except KeyboardInterrupt:
-        print("pegame: interrupted; the games stored so far are kept (resume=true completes the run)",
-              file=sys.stderr)
+        print(
+            "pegame: interrupted; the games stored so far are kept (resume=true completes the run)",
+            file=sys.stderr,
+        )
         sys.exit(130)
     sys.exit(sweep.worst())
 

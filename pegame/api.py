@@ -43,10 +43,35 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
     from pegame.grid import OccupancyGrid
 
 __all__ = [
-    "EMPTY_BELIEF", "STOP", "Belief", "Body", "BoundingBox", "Camera", "Context", "Detection",
-    "Detector", "Estimator", "Evader", "EvaderObservation", "INTERFACES", "PLUGIN_KINDS", "Plan",
-    "Plugin", "PluginKind", "Pose", "Pursuer", "PursuerObservation", "Recorder", "Region",
-    "SensorFrame", "Simulator", "Strategy", "Tick", "Velocity", "clamp", "wrap_angle",
+    "EMPTY_BELIEF",
+    "STOP",
+    "Belief",
+    "Body",
+    "BoundingBox",
+    "Camera",
+    "Context",
+    "Detection",
+    "Detector",
+    "Estimator",
+    "Evader",
+    "EvaderObservation",
+    "INTERFACES",
+    "PLUGIN_KINDS",
+    "Plan",
+    "Plugin",
+    "PluginKind",
+    "Pose",
+    "Pursuer",
+    "PursuerObservation",
+    "Recorder",
+    "Region",
+    "SensorFrame",
+    "Simulator",
+    "Strategy",
+    "Tick",
+    "Velocity",
+    "clamp",
+    "wrap_angle",
 ]
 
 
@@ -124,7 +149,7 @@ class Tick:
 # ----------------------------------------------------------------------- interfaces
 
 
-class Plugin(ABC):
+class Plugin(ABC):  # noqa: B024 - an abstract base for the interfaces, which add the methods
     """Base of every plugin: holds its validated config, the game context and its RNG.
 
     Subclasses set ``Config`` to a dataclass of their parameters and ``description`` to a

@@ -19,19 +19,20 @@ import resource
 import statistics
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from pegame import registry
 from pegame.api import Context, EvaderObservation, PursuerObservation
-from pegame.types import Body, Camera, Pose
 from pegame.config import compose, resolve_map_path
 from pegame.game import Game
-from pegame.visibility import MaskRegion, VisibilityRegion, visibility_region
 from pegame.grid import OccupancyGrid, load_map
 from pegame.navigation import Planner
+from pegame.types import Body, Camera, Pose
+from pegame.visibility import MaskRegion, VisibilityRegion, visibility_region
 
 PAPER_MAPS = ("hall", "enclosed", "brick")
 
@@ -70,7 +71,10 @@ def free_poses(grid: OccupancyGrid, radius: float, n: int, seed: int = 0) -> lis
     rng = np.random.default_rng(seed)
     rows, cols = np.nonzero(Planner.shared(grid, radius).traversable)
     picks = rng.integers(rows.size, size=n)
-    return [Pose(*grid.cell_to_world(rows[k], cols[k]), float(rng.uniform(-math.pi, math.pi))) for k in picks]
+    return [
+        Pose(*grid.cell_to_world(rows[k], cols[k]), float(rng.uniform(-math.pi, math.pi)))
+        for k in picks
+    ]
 
 
 def bench_visibility(grid: OccupancyGrid, repeat: int) -> float:
@@ -90,8 +94,8 @@ def bench_planner(grid: OccupancyGrid, repeat: int) -> tuple[float, float]:
 
 def bench_sim_steps(grid: OccupancyGrid, steps: int) -> float:
     """Grid-simulator control steps per second (both agents moving)."""
-    from pegame.types import Velocity
     from pegame.sims.grid import GridSimulator
+    from pegame.types import Velocity
 
     context = Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
@@ -120,7 +124,11 @@ def games_per_second(overrides: list[str], games: int, out_dir: str) -> float:
 
 def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]:
     """ms per decision of the smart pursuer (estimator update + plan) and smart evader."""
-    out: dict[str, float | None] = {"pursuer_decision_ms": None, "evader_decision_ms": None, "pf_step_ms": None}
+    out: dict[str, float | None] = {
+        "pursuer_decision_ms": None,
+        "evader_decision_ms": None,
+        "pf_step_ms": None,
+    }
     camera = Camera()
     context = Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), camera, 0.1, 1.0)
     poses = free_poses(grid, 0.25, 2 * repeat + 2, seed=3)
@@ -141,7 +149,9 @@ def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]
         out["pf_step_ms"] = median_ms(pf_step, repeat)
         if "smart" in registry.available("pursuer"):
             pcls = registry.load("pursuer", "smart")
-            pursuer = pcls(registry.make_config("pursuer", pcls, {}), context, np.random.default_rng(1))
+            pursuer = pcls(
+                registry.make_config("pursuer", pcls, {}), context, np.random.default_rng(1)
+            )
             pursuer.reset(p0)
             it2 = iter(list(zip(pairs, masks)) * 2)
 
@@ -173,7 +183,7 @@ def warehouse(height: int = 1000, width: int = 1667, resolution: float = 0.03) -
     shelf_h, shelf_w = int(1.0 / resolution), int(8.0 / resolution)
     for row in range(int(3.0 / resolution), height - shelf_h - 60, int(3.5 / resolution)):
         for col in range(int(3.0 / resolution), width - shelf_w - 60, int(11.0 / resolution)):
-            data[row:row + shelf_h, col:col + shelf_w] = 100
+            data[row : row + shelf_h, col : col + shelf_w] = 100
     return OccupancyGrid(data, resolution, name="warehouse")
 
 
@@ -211,7 +221,9 @@ def recorder_cost(games: int, out_dir: str) -> tuple[float | None, float | None]
     if not all("smart" in registry.available(g) for g in ("pursuer", "evader")):
         return None, None
     base = ["pursuer=smart", "evader=smart", "env=enclosed"]
-    games_per_second([*base, "recorder=rerun"], 1, out_dir)  # imports rerun-sdk, compiles the outline kernel
+    games_per_second(
+        [*base, "recorder=rerun"], 1, out_dir
+    )  # imports rerun-sdk, compiles the outline kernel
     ratios = []
     for seed in range(games):
         plain, recorded = (
@@ -236,7 +248,9 @@ def plugin_figures(quick: bool) -> dict[str, float | None]:
     """The 3D plugins' figures: pybullet real-time factor of a 90 s S-S game (camera at
     10 Hz, 160x120) and the vision detector's precision and recall against segmentation;
     null when the plugin distributions are not installed."""
-    figures: dict[str, float | None] = dict.fromkeys(("pybullet_rtf", "vision_precision", "vision_recall"))
+    figures: dict[str, float | None] = dict.fromkeys(
+        ("pybullet_rtf", "vision_precision", "vision_recall")
+    )
     try:
         from pegame_pybullet.bench import rtf
     except ImportError:
@@ -247,12 +261,17 @@ def plugin_figures(quick: bool) -> dict[str, float | None]:
     except ImportError:
         return figures
     scores = evaluate(seeds=range(1) if quick else range(3), t_max=30.0 if quick else 60.0)
-    figures["vision_precision"], figures["vision_recall"] = scores["vision_precision"], scores["vision_recall"]
+    figures["vision_precision"], figures["vision_recall"] = (
+        scores["vision_precision"],
+        scores["vision_recall"],
+    )
     return figures
 
 
 def main(argv: list[str] | None = None) -> dict[str, Any]:
-    parser = argparse.ArgumentParser(prog="python -m pegame.bench", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m pegame.bench", description=__doc__.splitlines()[0]
+    )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--quick", action="store_true", help="fewer repetitions (under a minute)")
     args = parser.parse_args(argv)
@@ -291,7 +310,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         report[key] = max(values) if values else None  # the worst paper map
     rates = [m["ss_games_per_s"] for m in per_map.values() if m.get("ss_games_per_s") is not None]
     report["ss_games_per_s"] = min(rates) if rates else None  # the slowest paper map
-    report["large_map_decision_ms"], report["large_map_peak_mb"] = large_map_decision(max(5, repeat // 10))
+    report["large_map_decision_ms"], report["large_map_peak_mb"] = large_map_decision(
+        max(5, repeat // 10)
+    )
     report["env_steps_per_s"] = env_steps_per_second(2 if args.quick else 10)
     report.update(plugin_figures(args.quick))
     report["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
@@ -313,25 +334,37 @@ def format_report(report: dict[str, Any]) -> str:
     m = report["machine"]
     lines = [f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}, numpy {m['numpy']}"]
     lines.append(f"jit warm-up (first calls): {report['jit_warmup_s']:.2f} s")
-    lines.append(f"{'map':<10}{'cells':>10}{'visib ms':>10}{'field ms':>10}{'plan ms':>9}"
-                 f"{'pf ms':>8}{'P dec ms':>10}{'E dec ms':>10}{'S-S games/s':>13}")
+    lines.append(
+        f"{'map':<10}{'cells':>10}{'visib ms':>10}{'field ms':>10}{'plan ms':>9}"
+        f"{'pf ms':>8}{'P dec ms':>10}{'E dec ms':>10}{'S-S games/s':>13}"
+    )
     for name, row in report["maps"].items():
         cells = "x".join(map(str, row["cells"]))
-        lines.append(f"{name:<10}{cells:>10}{fmt(row['visibility_ms']):>10}{fmt(row['distance_field_ms']):>10}"
-                     f"{fmt(row['plan_ms']):>9}{fmt(row.get('pf_step_ms')):>8}"
-                     f"{fmt(row.get('pursuer_decision_ms')):>10}{fmt(row.get('evader_decision_ms')):>10}"
-                     f"{fmt(row.get('ss_games_per_s')):>13}")
+        lines.append(
+            f"{name:<10}{cells:>10}{fmt(row['visibility_ms']):>10}{fmt(row['distance_field_ms']):>10}"
+            f"{fmt(row['plan_ms']):>9}{fmt(row.get('pf_step_ms')):>8}"
+            f"{fmt(row.get('pursuer_decision_ms')):>10}{fmt(row.get('evader_decision_ms')):>10}"
+            f"{fmt(row.get('ss_games_per_s')):>13}"
+        )
     lines.append(f"grid sim: {report['sim_steps_per_s']:.0f} control steps/s")
-    lines.append(f"90 s games/s (one core): R-R {fmt(report['rr_games_per_s'])} (enclosed), "
-                 f"S-S {fmt(report['ss_games_per_s'])} (the slowest paper map)")
+    lines.append(
+        f"90 s games/s (one core): R-R {fmt(report['rr_games_per_s'])} (enclosed), "
+        f"S-S {fmt(report['ss_games_per_s'])} (the slowest paper map)"
+    )
     overhead = report["recorder_overhead"]
-    lines.append(f"recorder: +{fmt(None if overhead is None else 100 * overhead)}% game time, "
-                 f"{fmt(report['rrd_mb_per_game'])} MB per 90 s game")
+    lines.append(
+        f"recorder: +{fmt(None if overhead is None else 100 * overhead)}% game time, "
+        f"{fmt(report['rrd_mb_per_game'])} MB per 90 s game"
+    )
     lines.append(f"env steps/s (PettingZoo, random actions): {fmt(report['env_steps_per_s'])}")
-    lines.append(f"pybullet S-S real-time factor: {fmt(report['pybullet_rtf'])}; vision vs segmentation: "
-                 f"precision {fmt(report['vision_precision'])}, recall {fmt(report['vision_recall'])}")
-    lines.append(f"warehouse 1000x1667 cells: {fmt(report['large_map_decision_ms'])} ms per decision tick, "
-                 f"peak {fmt(report['large_map_peak_mb'])} MB")
+    lines.append(
+        f"pybullet S-S real-time factor: {fmt(report['pybullet_rtf'])}; vision vs segmentation: "
+        f"precision {fmt(report['vision_precision'])}, recall {fmt(report['vision_recall'])}"
+    )
+    lines.append(
+        f"warehouse 1000x1667 cells: {fmt(report['large_map_decision_ms'])} ms per decision tick, "
+        f"peak {fmt(report['large_map_peak_mb'])} MB"
+    )
     return "\n".join(lines)
 
 

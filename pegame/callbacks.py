@@ -37,7 +37,7 @@ class ReportCallback(Callback):
         sweep_dir = config.hydra.sweep.dir
         try:
             write_report(sweep_dir)
-        except Exception as exc:  # noqa: BLE001 - a report problem must not hide the results
+        except Exception as exc:
             log.error("could not write the sweep report in %s: %s", sweep_dir, exc)
         else:
             log.info("sweep report written in %s", sweep_dir)

@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import difflib
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, make_dataclass
 from importlib.metadata import entry_points
 from pathlib import Path
-from typing import Any, Mapping, Sequence, get_type_hints
+from typing import Any, get_type_hints
 
 from hydra.core.config_search_path import ConfigSearchPath
 from hydra.core.config_store import ConfigStore
@@ -25,23 +26,25 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from pegame.api import PLUGIN_KINDS
-from pegame.types import Camera
 from pegame.errors import ConfigError, require
+from pegame.types import Camera
 
 
 @dataclass
 class GameConfig:
     """The game protocol (paper, Sec. "Simulation based validation")."""
 
-    seed: int = 0  # master seed; every component derives its own generator from it
-    t_max: float = 90.0  # game length (s)
-    control_hz: float = 10.0  # control rate: integration, sensing, commands (Hz)
-    decision_hz: float = 1.0  # decision rate of both strategies (Hz); the paper's 1 Hz
-    speed_ratio: float = 1.0  # pursuer max speed / evader max speed (v_p / v_e)
-    trials: int = 1  # games in one job, with seeds seed, seed + 1, ...
+    seed: int = 0  # master seed; every component gets its own generator from it
+    t_max: float = 90.0  # game length (s), the paper's t_max
+    control_hz: float = 10.0  # sensing, estimation and velocity commands (Hz)
+    decision_hz: float = 1.0  # both strategies decide at this rate (Hz), the paper's 1 Hz nodes
+    speed_ratio: float = 1.0  # v_p / v_e: the pursuer's max speed is this times evader.v_max
+    trials: int = 1  # games per job, seeds seed, seed+1, ...; each appends a line to results.jsonl
 
     def __post_init__(self) -> None:
-        require(self.seed >= 0, "game.seed", "a whole number >= 0 (numpy's SeedSequence)", self.seed)
+        require(
+            self.seed >= 0, "game.seed", "a whole number >= 0 (numpy's SeedSequence)", self.seed
+        )
         require(self.t_max > 0, "game.t_max", "a positive duration in seconds", self.t_max)
         require(self.trials >= 1, "game.trials", "a whole number >= 1", self.trials)
         for key in ("control_hz", "decision_hz", "speed_ratio"):
@@ -94,20 +97,24 @@ def _schema_of(frozen: type) -> type:
     ``frozen``: Hydra needs writable schema nodes; range checks run on ``typed(node, frozen)``."""
     hints = get_type_hints(frozen)
     return make_dataclass(
-        f"{frozen.__name__}Schema", [(f.name, hints[f.name], field(default=f.default)) for f in fields(frozen)]
+        f"{frozen.__name__}Schema",
+        [(f.name, hints[f.name], field(default=f.default)) for f in fields(frozen)],
     )
 
 
 #: The whole run config: the fixed nodes, one node per plugin kind of
 #: :data:`pegame.api.PLUGIN_KINDS` (typed by its plugin's Config when a game is built), and
 #: ``resume`` (skip games already stored in the job's results.jsonl).
-Schema = make_dataclass("Schema", [
-    ("game", GameConfig, field(default_factory=GameConfig)),
-    ("camera", Any, field(default_factory=_schema_of(Camera))),
-    ("env", EnvConfig, field(default_factory=EnvConfig)),
-    *[(kind, Any, field(default=MISSING)) for kind in PLUGIN_KINDS],
-    ("resume", bool, field(default=False)),
-])
+Schema = make_dataclass(
+    "Schema",
+    [
+        ("game", GameConfig, field(default_factory=GameConfig)),
+        ("camera", Any, field(default_factory=_schema_of(Camera))),
+        ("env", EnvConfig, field(default_factory=EnvConfig)),
+        *[(kind, Any, field(default=MISSING)) for kind in PLUGIN_KINDS],
+        ("resume", bool, field(default=False)),
+    ],
+)
 
 
 def check_known_keys(cfg: Mapping[str, Any]) -> None:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import io
 import textwrap
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -53,13 +53,23 @@ def plot_trajectory(
     axes = figure.add_subplot()
     ox, oy, yaw = grid.origin
     width, height = grid.width * grid.resolution, grid.height * grid.resolution
-    image = axes.imshow(map_shades(grid), cmap="gray", vmin=0.0, vmax=1.0, origin="lower",
-                        extent=(ox, ox + width, oy, oy + height), interpolation="nearest")
+    image = axes.imshow(
+        map_shades(grid),
+        cmap="gray",
+        vmin=0.0,
+        vmax=1.0,
+        origin="lower",
+        extent=(ox, ox + width, oy, oy + height),
+        interpolation="nearest",
+    )
     if yaw:
         # The grid is rotated by yaw about its origin corner.
         image.set_transform(Affine2D().rotate_around(ox, oy, yaw) + axes.transData)
-        corners = Affine2D().rotate_around(ox, oy, yaw).transform(
-            [(ox, oy), (ox + width, oy), (ox, oy + height), (ox + width, oy + height)])
+        corners = (
+            Affine2D()
+            .rotate_around(ox, oy, yaw)
+            .transform([(ox, oy), (ox + width, oy), (ox, oy + height), (ox + width, oy + height)])
+        )
         axes.set_xlim(corners[:, 0].min(), corners[:, 0].max())
         axes.set_ylim(corners[:, 1].min(), corners[:, 1].max())
     for name, color in (("pursuer", PURSUER_COLOR), ("evader", EVADER_COLOR)):
@@ -71,7 +81,10 @@ def plot_trajectory(
     axes.set_xlabel("x (m)")
     axes.set_ylabel("y (m)")
     axes.legend(loc="best", framealpha=0.9)
-    axes.set_title(textwrap.fill(title, 70) if title else _title(grid.name, pairing, tracking_rate), fontsize=10)
+    axes.set_title(
+        textwrap.fill(title, 70) if title else _title(grid.name, pairing, tracking_rate),
+        fontsize=10,
+    )
     figure.tight_layout()
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png")

@@ -108,8 +108,16 @@ class Outcome:
 
 
 TRAJECTORY_HEADER = (
-    "step", "time", "pursuer_x", "pursuer_y", "pursuer_theta",
-    "evader_x", "evader_y", "evader_theta", "detected", "in_view",
+    "step",
+    "time",
+    "pursuer_x",
+    "pursuer_y",
+    "pursuer_theta",
+    "evader_x",
+    "evader_y",
+    "evader_theta",
+    "detected",
+    "in_view",
 )
 
 
@@ -135,7 +143,9 @@ class Scenario:
         evader_cfg, pursuer_cfg = self.configs["evader"], self.configs["pursuer"]
         self.context = Context(
             grid=grid,
-            pursuer=Body(pursuer_cfg.radius, self.settings.speed_ratio * evader_cfg.v_max, pursuer_cfg.w_max),
+            pursuer=Body(
+                pursuer_cfg.radius, self.settings.speed_ratio * evader_cfg.v_max, pursuer_cfg.w_max
+            ),
             evader=Body(evader_cfg.radius, evader_cfg.v_max, evader_cfg.w_max),
             camera=camera,
             control_dt=1.0 / self.settings.control_hz,
@@ -155,8 +165,12 @@ class Game:
     ``base_dir``); seed: the master seed, by default the config's ``game.seed``.
     """
 
-    def __init__(self, source: Scenario | DictConfig, seed: int | None = None,
-                 base_dir: str | Path | None = None) -> None:
+    def __init__(
+        self,
+        source: Scenario | DictConfig,
+        seed: int | None = None,
+        base_dir: str | Path | None = None,
+    ) -> None:
         scenario = source if isinstance(source, Scenario) else Scenario(source, base_dir)
         self.scenario = scenario
         self.seed = scenario.settings.seed if seed is None else seed
@@ -164,22 +178,28 @@ class Game:
         streams = dict(zip(STREAMS, np.random.SeedSequence(self.seed).spawn(len(STREAMS))))
         self.spawn_rng = np.random.default_rng(streams["spawn"])
         self.plugins = {
-            kind: scenario.classes[kind](scenario.configs[kind], self.context, np.random.default_rng(streams[kind]))
+            kind: scenario.classes[kind](
+                scenario.configs[kind], self.context, np.random.default_rng(streams[kind])
+            )
             for kind in INTERFACES
         }
 
     def start(self, external: tuple[str, ...] = (), estimate: bool = True) -> TickLoop:
         """Spawn both agents and return the game's tick loop at tick 0 (see TickLoop)."""
         settings = self.scenario.settings
-        loop = TickLoop(self.plugins, self.context, settings.ticks, settings.decide_every, external,
-                        estimate)
+        loop = TickLoop(
+            self.plugins, self.context, settings.ticks, settings.decide_every, external, estimate
+        )
         loop.start(*spawn(self.context, self.spawn_rng))
         return loop
 
     def play(self, out_dir: str | Path, recording_name: str = "game") -> Outcome:
         """Play the game; the recorder (if any) writes ``recording_name`` into ``out_dir``."""
         recorder = self.plugins["recorder"]
-        config = {**self.scenario.config, "game": {**self.scenario.config["game"], "seed": self.seed}}
+        config = {
+            **self.scenario.config,
+            "game": {**self.scenario.config["game"], "seed": self.seed},
+        }
         try:
             loop = self.start()
             recorder.start(str(out_dir), recording_name, config)
@@ -188,8 +208,20 @@ class Game:
                 while not loop.done:
                     t = loop.advance()
                     p, e = t.pursuer, t.evader
-                    trajectory.append((t.step, round(t.time, 6), p.x, p.y, p.theta, e.x, e.y, e.theta,
-                                       int(t.detection is not None), int(t.in_view)))
+                    trajectory.append(
+                        (
+                            t.step,
+                            round(t.time, 6),
+                            p.x,
+                            p.y,
+                            p.theta,
+                            e.x,
+                            e.y,
+                            e.theta,
+                            int(t.detection is not None),
+                            int(t.in_view),
+                        )
+                    )
                 result = self._result(loop.metrics)
             except BaseException as error:
                 recorder.abort(error)

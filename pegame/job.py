@@ -27,9 +27,10 @@ import os
 import sys
 import time
 import traceback
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import Any
 
 from omegaconf import DictConfig
 
@@ -83,7 +84,11 @@ def stored_seeds(path: Path, config: dict[str, Any]) -> set[int]:
             continue
         if entry.get("config_hash") != digest:
             other = entry.get("config")
-            keys = differing_keys(other, config) if isinstance(other, dict) else ["(unrecorded config)"]
+            keys = (
+                differing_keys(other, config)
+                if isinstance(other, dict)
+                else ["(unrecorded config)"]
+            )
             raise JobDirectoryError(
                 f"{path} holds games of another config (seed {entry.get('seed')}); this job "
                 f"differs in: {', '.join(keys)}. One job directory holds one config's games: "
@@ -111,7 +116,11 @@ def append_line(path: Path, entry: dict[str, Any]) -> None:
             handle.write(line)
             handle.flush()
     except OSError as exc:
-        print(f"pegame: this line could not be written to {path}:\n{line.decode()}", file=sys.stderr, end="")
+        print(
+            f"pegame: this line could not be written to {path}:\n{line.decode()}",
+            file=sys.stderr,
+            end="",
+        )
         raise ResultsWriteError(
             f"Could not write to {path}: {exc.strerror or exc}. The unwritten line is printed "
             f"above on stderr; free space or choose another output directory, then run again "
@@ -153,9 +162,15 @@ def _run_locked(
     done = stored if cfg.get("resume", False) else set()
     seeds = [s for s in range(settings.seed, settings.seed + settings.trials) if s not in done]
     if done:
-        log.info("resume: %d of %d games already stored", settings.trials - len(seeds), settings.trials)
-    identity = {"config": config, "config_hash": config_hash(config), "overrides": overrides,
-                "provenance": provenance()}
+        log.info(
+            "resume: %d of %d games already stored", settings.trials - len(seeds), settings.trials
+        )
+    identity = {
+        "config": config,
+        "config_hash": config_hash(config),
+        "overrides": overrides,
+        "provenance": provenance(),
+    }
     single, parent, run = settings.trials == 1, sweep.sweep_parent(), JobRun()
     for seed in progress(seeds):
         if sweep.orphaned(parent):
@@ -164,7 +179,7 @@ def _run_locked(
         try:
             game = scenario.game(seed)
             outcome = game.play(out_dir, "game" if single else f"game_{seed}")
-        except Exception as exc:  # noqa: BLE001 - a failing game must not stop the job
+        except Exception as exc:
             run.failed.append(seed)
             record_failure(out_dir, seed, cfg, exc, identity)
             continue
@@ -175,13 +190,16 @@ def _run_locked(
             write_single(outcome, game, out_dir)
         print(summary_line(outcome.result))
     rates = [r["tracking_rate"] for r in run.played]
-    append_line(results_path, {
-        "kind": "summary",
-        "games": len(run.played),
-        "failed": len(run.failed),
-        "tracking_rate_mean": round(sum(rates) / len(rates), 6) if rates else None,
-        "status": run.status,
-    })
+    append_line(
+        results_path,
+        {
+            "kind": "summary",
+            "games": len(run.played),
+            "failed": len(run.failed),
+            "tracking_rate_mean": round(sum(rates) / len(rates), 6) if rates else None,
+            "status": run.status,
+        },
+    )
     return run
 
 
@@ -216,8 +234,11 @@ def stop_orphaned(stored: int) -> None:
     """Exit this worker process at once: the sweep's process died, so nothing would
     collect its work and a resume may already be running. The games stored so far stay
     (each line was flushed when its game finished); the lock goes with the process."""
-    log.warning("the sweep's process died: this worker stops after %d games played now; "
-                "run the sweep again with resume=true to complete it", stored)
+    log.warning(
+        "the sweep's process died: this worker stops after %d games played now; "
+        "run the sweep again with resume=true to complete it",
+        stored,
+    )
     logging.shutdown()
     os._exit(sweep.GAMES_FAILED)
 
@@ -226,11 +247,14 @@ def write_invalid(out_dir: str | Path, error: PegameError, overrides: Sequence[s
     """Record a multirun job whose config cannot be played: one ``invalid`` line, so the
     sweep report shows the cell as failed and the other cells still run."""
     Path(out_dir).mkdir(parents=True, exist_ok=True)
-    append_line(Path(out_dir) / RESULTS, {
-        "kind": "invalid",
-        "error": " ".join(str(error).split()),
-        "overrides": list(overrides),
-    })
+    append_line(
+        Path(out_dir) / RESULTS,
+        {
+            "kind": "invalid",
+            "error": " ".join(str(error).split()),
+            "overrides": list(overrides),
+        },
+    )
 
 
 def write_single(outcome: Outcome, game: Game, out_dir: Path) -> None:
@@ -238,8 +262,12 @@ def write_single(outcome: Outcome, game: Game, out_dir: Path) -> None:
     from pegame.figures import plot_trajectory
 
     try:
-        plot_trajectory(game.context.grid, outcome.trajectory, out_dir / "trajectory.png",
-                        title=summary_line(outcome.result))
+        plot_trajectory(
+            game.context.grid,
+            outcome.trajectory,
+            out_dir / "trajectory.png",
+            title=summary_line(outcome.result),
+        )
         write_outcome(outcome, out_dir)
     except OSError as exc:
         raise ResultsWriteError(
@@ -256,13 +284,16 @@ def record_failure(
     text = "".join(traceback.format_exception(exc))
     write_atomic(out_dir / f"failed_{seed}.txt", text)
     log.error("seed %d failed: %s (traceback in failed_%d.txt)", seed, exc, seed)
-    append_line(out_dir / RESULTS, {
-        "kind": "failed",
-        "seed": seed,
-        "pairing": pairing(str(cfg.pursuer.name), str(cfg.evader.name)),
-        "map": str(cfg.env.name),
-        "speed_ratio": float(cfg.game.speed_ratio),
-        "error": f"{type(exc).__name__}: {exc}".splitlines()[0],
-        "traceback_file": f"failed_{seed}.txt",
-        **identity,
-    })
+    append_line(
+        out_dir / RESULTS,
+        {
+            "kind": "failed",
+            "seed": seed,
+            "pairing": pairing(str(cfg.pursuer.name), str(cfg.evader.name)),
+            "map": str(cfg.env.name),
+            "speed_ratio": float(cfg.game.speed_ratio),
+            "error": f"{type(exc).__name__}: {exc}".splitlines()[0],
+            "traceback_file": f"failed_{seed}.txt",
+            **identity,
+        },
+    )

@@ -34,18 +34,29 @@ ROLES = ("pursuer", "evader")
 class TickLoop:
     """Plays the ticks of one game in the order of the module docstring.
 
-    plugins: the game's plugins by kind (``sim``, ``detector``, ...); context: its context; ticks: control ticks in the game;
-    decide_every: control ticks per decision; external: the roles commanded by the caller;
-    estimate: run the estimator and build the region (forced on when the pursuer is a
-    strategy, which needs them).
+    plugins: the game's plugins by kind (``sim``, ``detector``, ...); context: its context;
+    ticks: control ticks in the game; decide_every: control ticks per decision; external:
+    the roles commanded by the caller; estimate: run the estimator and build the region
+    (forced on when the pursuer is a strategy, which needs them).
     """
 
-    def __init__(self, plugins: Mapping[str, Plugin], context: Context, ticks: int, decide_every: int,
-                 external: Sequence[str] = (), estimate: bool = True) -> None:
+    def __init__(
+        self,
+        plugins: Mapping[str, Plugin],
+        context: Context,
+        ticks: int,
+        decide_every: int,
+        external: Sequence[str] = (),
+        estimate: bool = True,
+    ) -> None:
         unknown = sorted(set(external) - set(ROLES))
         if unknown:
             raise ValueError(f"external roles must be among {ROLES}, got {unknown}.")
-        self.sim, self.detector, self.estimator = plugins["sim"], plugins["detector"], plugins["estimator"]
+        self.sim, self.detector, self.estimator = (
+            plugins["sim"],
+            plugins["detector"],
+            plugins["estimator"],
+        )
         self.pursuer_strategy, self.evader_strategy = plugins["pursuer"], plugins["evader"]
         self.recorder = plugins["recorder"]
         self.context = context
@@ -126,10 +137,22 @@ class TickLoop:
         if e_obs is not None:
             commanded["evader"] = self.evader_strategy.control(e_obs)
         velocities = (commanded["pursuer"], commanded["evader"])
-        self.metrics.add(self.pursuer, self.evader, self.detection is not None, self.in_view,
-                         self.belief)
-        tick = Tick(self.step, self.time, self.pursuer, self.evader, self.frame, self.detection,
-                    self.belief, self.region, self.in_view, velocities, self.plans)
+        self.metrics.add(
+            self.pursuer, self.evader, self.detection is not None, self.in_view, self.belief
+        )
+        tick = Tick(
+            self.step,
+            self.time,
+            self.pursuer,
+            self.evader,
+            self.frame,
+            self.detection,
+            self.belief,
+            self.region,
+            self.in_view,
+            velocities,
+            self.plans,
+        )
         self.recorder.log(tick)
         self.sim.step(velocities[0], velocities[1], self.context.control_dt)
         self.step += 1

@@ -50,7 +50,9 @@ class TrackingMetrics:
         self.resamplings = 0
         self.detected_ticks = 0
 
-    def add(self, pursuer: Pose, evader: Pose, detected: bool, in_view: bool, belief: Belief) -> None:
+    def add(
+        self, pursuer: Pose, evader: Pose, detected: bool, in_view: bool, belief: Belief
+    ) -> None:
         """Record one control tick: true poses, detection, ground-truth visibility, belief."""
         self.pursuer.append((pursuer.x, pursuer.y))
         self.evader.append((evader.x, evader.y))

@@ -29,11 +29,11 @@ from typing import Any
 import numpy as np
 
 from pegame.api import Context
-from pegame.types import Body, Plan, Velocity
 from pegame.envs.actions import to_velocity
 from pegame.envs.observations import EvaderFeatures, ObservationSettings, PursuerFeatures
 from pegame.envs.settings import EnvSettings
 from pegame.errors import ConfigError, require
+from pegame.types import Body, Plan, Velocity
 
 #: version of the .npz layout written by save()
 FORMAT = 1
@@ -58,8 +58,14 @@ class LinearPolicy:
         """Write the policy to ``path`` (.npz, no pickled objects)."""
         s = self.settings
         np.savez(
-            path, format=FORMAT, weights=self.weights, bias=self.bias, role=self.role,
-            crop_cells=s.crop_cells, crop_resolution=s.crop_resolution, belief=s.belief,
+            path,
+            format=FORMAT,
+            weights=self.weights,
+            bias=self.bias,
+            role=self.role,
+            crop_cells=s.crop_cells,
+            crop_resolution=s.crop_resolution,
+            belief=s.belief,
             decision_period=np.nan if self.decision_period is None else self.decision_period,
         )
 
@@ -75,8 +81,11 @@ class LinearPolicy:
                 )
                 period = float(data["decision_period"])
                 policy = cls(
-                    np.asarray(data["weights"], dtype=np.float64), np.asarray(data["bias"], dtype=np.float64),
-                    str(data["role"]), settings, None if math.isnan(period) else period,
+                    np.asarray(data["weights"], dtype=np.float64),
+                    np.asarray(data["bias"], dtype=np.float64),
+                    str(data["role"]),
+                    settings,
+                    None if math.isnan(period) else period,
                 )
         except (OSError, KeyError, ValueError) as exc:
             raise ConfigError(f"Policy file {path}: not a pegame linear policy ({exc}).") from None
@@ -92,29 +101,51 @@ class LinearPolicy:
 class PolicyOptions:
     """The ``policy`` strategies' parameters (on top of the role's body parameters)."""
 
-    path: str = ""  # a linear-policy .npz file, or "package.module:function" (a callable obs -> action)
+    path: str = (
+        ""  # a linear-policy .npz file, or "package.module:function" (a callable obs -> action)
+    )
     crop_cells: int | None = None  # observation crop, cells per side; None: the .npz's, else 32
     crop_resolution: float | None = None  # m per crop cell; None: the .npz's, else 0.2
-    belief: bool | None = None  # observe the estimator's summary (pursuer); None: the .npz's, else false
-    decision_period: float | None = None  # s an action is held; None: the .npz's, else one control tick
+    belief: bool | None = (
+        None  # observe the estimator's summary (pursuer); None: the .npz's, else false
+    )
+    decision_period: float | None = (
+        None  # s an action is held; None: the .npz's, else one control tick
+    )
 
     def check(self, role: str) -> None:
         """Range checks, naming ``role.key``; an empty path is caught when the strategy is built."""
         require(
             self.path == "" or self.path.endswith(".npz") or ":" in self.path,
-            f"{role}.path", "a .npz policy file or 'package.module:function'", self.path,
+            f"{role}.path",
+            "a .npz policy file or 'package.module:function'",
+            self.path,
         )
-        require(role == "pursuer" or not self.belief, f"{role}.belief", "null or false (only the pursuer has a belief)",
-                self.belief)
-        require(self.crop_cells is None or self.crop_cells >= 1, f"{role}.crop_cells",
-                "a whole number >= 1, or null", self.crop_cells)
+        require(
+            role == "pursuer" or not self.belief,
+            f"{role}.belief",
+            "null or false (only the pursuer has a belief)",
+            self.belief,
+        )
+        require(
+            self.crop_cells is None or self.crop_cells >= 1,
+            f"{role}.crop_cells",
+            "a whole number >= 1, or null",
+            self.crop_cells,
+        )
         for key in ("crop_resolution", "decision_period"):
             value = getattr(self, key)
-            require(value is None or (value > 0 and math.isfinite(value)), f"{role}.{key}",
-                    "a positive number, or null", value)
+            require(
+                value is None or (value > 0 and math.isfinite(value)),
+                f"{role}.{key}",
+                "a positive number, or null",
+                value,
+            )
 
 
-def load_policy(path: str, role: str, base_dir: str | Path | None = None) -> Callable[[np.ndarray], Any]:
+def load_policy(
+    path: str, role: str, base_dir: str | Path | None = None
+) -> Callable[[np.ndarray], Any]:
     """The policy named by ``path`` (see the module docstring): a LinearPolicy for a .npz
     (relative paths from ``base_dir``, default the working directory), else the callable
     at ``module:attribute``. ConfigError naming ``role.path`` when it cannot be loaded."""
@@ -123,10 +154,14 @@ def load_policy(path: str, role: str, base_dir: str | Path | None = None) -> Cal
         if not file.is_absolute():
             file = Path(base_dir or Path.cwd()) / file
         if not file.is_file():
-            raise ConfigError(f"Invalid value for '{role}.path': policy file {file} does not exist.")
+            raise ConfigError(
+                f"Invalid value for '{role}.path': policy file {file} does not exist."
+            )
         policy = LinearPolicy.load(file)
         if policy.role != role:
-            raise ConfigError(f"Invalid value for '{role}.path': {file} is a policy for the {policy.role}.")
+            raise ConfigError(
+                f"Invalid value for '{role}.path': {file} is a policy for the {policy.role}."
+            )
         return policy
     module_name, _, attribute = path.partition(":")
     try:
@@ -134,7 +169,9 @@ def load_policy(path: str, role: str, base_dir: str | Path | None = None) -> Cal
         for part in attribute.split("."):
             target = getattr(target, part)
     except (ImportError, AttributeError) as exc:
-        raise ConfigError(f"Invalid value for '{role}.path': cannot load {path!r} ({exc}).") from None
+        raise ConfigError(
+            f"Invalid value for '{role}.path': cannot load {path!r} ({exc})."
+        ) from None
     if not callable(target):
         raise ConfigError(f"Invalid value for '{role}.path': {path!r} is not callable.")
     return target
@@ -152,10 +189,15 @@ class PolicyPlayer:
         self.policy = load_policy(options.path, role)
         trained = self.policy if isinstance(self.policy, LinearPolicy) else None
         # The strategy's option wins, then what the policy was trained with, then the env default.
-        stored = {} if trained is None else {**asdict(trained.settings), "decision_period": trained.decision_period}
+        stored = (
+            {}
+            if trained is None
+            else {**asdict(trained.settings), "decision_period": trained.decision_period}
+        )
         picked = {
             key: value if value is not None else stored.get(key, getattr(EnvSettings, key))
-            for key, value in ((f.name, getattr(options, f.name)) for f in fields(PolicyOptions)) if key != "path"
+            for key, value in ((f.name, getattr(options, f.name)) for f in fields(PolicyOptions))
+            if key != "path"
         }
         settings = EnvSettings(**picked)
         features = PursuerFeatures if role == "pursuer" else EvaderFeatures
@@ -185,6 +227,8 @@ class PolicyPlayer:
         self.features.update(observation)
         if self.tick % self.every == 0:
             action = self.policy(self.features(observation))
-            self.command = to_velocity(action, self.body, clip=True, who=f"the {self.role} policy's action")
+            self.command = to_velocity(
+                action, self.body, clip=True, who=f"the {self.role} policy's action"
+            )
         self.tick += 1
         return self.command

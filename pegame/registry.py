@@ -12,11 +12,12 @@ from __future__ import annotations
 import difflib
 import itertools
 import warnings
-from functools import lru_cache
+from collections.abc import Iterable, Mapping
+from functools import cache
 from importlib.metadata import EntryPoint, entry_points
-from typing import Any, Iterable, Mapping
+from typing import Any
 
-from pegame.api import INTERFACES, PLUGIN_KINDS
+from pegame.api import INTERFACES, PLUGIN_KINDS, Plugin
 from pegame.errors import PegameError
 
 #: config group -> entry-point group, derived from :data:`pegame.api.PLUGIN_KINDS`
@@ -43,8 +44,8 @@ def unique_by_name(points: Iterable[EntryPoint]) -> dict[str, EntryPoint]:
     ``backends/plugins.py``)."""
     ranked = sorted(points, key=lambda ep: (ep.name, distribution_of(ep), ep.value))
     unique = {}
-    for name, same in itertools.groupby(ranked, key=lambda ep: ep.name):
-        same = list(same)
+    for name, group in itertools.groupby(ranked, key=lambda ep: ep.name):
+        same = list(group)
         if len(same) > 1:
             who = ", ".join(f"{distribution_of(ep)} ({ep.value})" for ep in same)
             warnings.warn(
@@ -58,7 +59,7 @@ def unique_by_name(points: Iterable[EntryPoint]) -> dict[str, EntryPoint]:
     return unique
 
 
-@lru_cache(maxsize=None)
+@cache
 def _entry_points(group: str) -> dict[str, EntryPoint]:
     return unique_by_name(entry_points(group=_entry_point_group(group)))
 
@@ -93,7 +94,7 @@ def distribution_of(point: EntryPoint) -> str:
     return dist.name if dist is not None else "?"
 
 
-def load(group: str, name: str) -> type:
+def load(group: str, name: str) -> type[Plugin]:
     """Import and return the plugin class ``name`` of ``group``, checking its interface."""
     point = entry_point(group, name)
     try:
@@ -133,7 +134,7 @@ def check_interface(group: str, name: str, point: EntryPoint, cls: Any) -> None:
         )
 
 
-def make_config(group: str, cls: type, params: Mapping[str, Any]) -> Any:
+def make_config(group: str, cls: type[Plugin], params: Mapping[str, Any]) -> Any:
     """Build a validated ``cls.Config`` from a config node's ``params`` (without ``name``);
     ConfigError names ``group.key`` and the allowed keys or range."""
     from pegame.config import typed

@@ -34,7 +34,9 @@ def find_recordings(run_dir: str | Path) -> list[Path]:
         raise ReplayError(
             f"'{root}' is not a directory; give a run's output directory (e.g. outputs/<date>/<time>)."
         )
-    files = sorted(path for path in root.rglob("*.rrd*") if path.is_file() and recording_status(path))
+    files = sorted(
+        path for path in root.rglob("*.rrd*") if path.is_file() and recording_status(path)
+    )
     if not files:
         raise ReplayError(
             f"No Rerun recordings (*.rrd) under '{root}'. Record games with recorder=rerun, "
@@ -60,11 +62,17 @@ def human_size(size: int) -> str:
 def main(argv: list[str] | None = None) -> int:
     """Command-line entry point; returns the exit status (2 when there is nothing to replay)."""
     parser = argparse.ArgumentParser(
-        prog="python -m pegame.replay", description="Open a run's Rerun recordings (*.rrd) in the Rerun viewer."
+        prog="python -m pegame.replay",
+        description="Open a run's Rerun recordings (*.rrd) in the Rerun viewer.",
     )
-    parser.add_argument("run_dir", help="a run's output directory, or any directory above several runs")
-    parser.add_argument("--list", action="store_true",
-                        help="list the recordings, their sizes and statuses (complete, failed, partial) instead")
+    parser.add_argument(
+        "run_dir", help="a run's output directory, or any directory above several runs"
+    )
+    parser.add_argument(
+        "--list",
+        action="store_true",
+        help="list the recordings, their sizes and statuses (complete, failed, partial) instead",
+    )
     args = parser.parse_args(argv)
     try:
         files = find_recordings(args.run_dir)
@@ -77,8 +85,11 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     readable = [path for path in files if recording_status(path) != PARTIAL]
     if len(readable) < len(files):
-        print(f"pegame.replay: {len(files) - len(readable)} partial recording(s) (a game running or killed) "
-              "not opened; see --list.", file=sys.stderr)
+        print(
+            f"pegame.replay: {len(files) - len(readable)} partial recording(s) (a game running or killed) "
+            "not opened; see --list.",
+            file=sys.stderr,
+        )
     if not readable:
         return 2
     return subprocess.call(viewer_command(readable))

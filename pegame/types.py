@@ -86,7 +86,9 @@ class Camera:
     def __post_init__(self) -> None:
         require(0 < self.fov <= 2 * math.pi, "camera.fov", "(0, 2*pi] radians", self.fov)
         require(self.near >= 0, "camera.near", "a range >= 0 m", self.near)
-        require(self.far > self.near, "camera.far", f"a range > camera.near ({self.near} m)", self.far)
+        require(
+            self.far > self.near, "camera.far", f"a range > camera.near ({self.near} m)", self.far
+        )
         for key in ("image_width", "image_height", "angle_step", "distance_step"):
             value = getattr(self, key)
             require(value > 0, f"camera.{key}", "a positive number", value)

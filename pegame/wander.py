@@ -10,15 +10,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from pegame.types import STOP, Body, Plan, Pose, Velocity
 from pegame.navigation import PathFollower, Planner
+from pegame.types import STOP, Body, Plan, Pose, Velocity
 
 
 class Wanderer:
     """Random goal navigation for one agent on ``grid`` with ``body``, drawing from ``rng``."""
 
-    def __init__(self, grid, body: Body, rng: np.random.Generator, stuck_distance: float = 0.05,
-                 stuck_decisions: int = 2) -> None:
+    def __init__(
+        self,
+        grid,
+        body: Body,
+        rng: np.random.Generator,
+        stuck_distance: float = 0.05,
+        stuck_decisions: int = 2,
+    ) -> None:
         self.grid = grid
         self.rng = rng
         self.planner = Planner.shared(grid, body.radius)

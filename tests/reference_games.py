@@ -29,7 +29,10 @@ CASES = [
     ("S-S stratified", ["env=enclosed", "estimator.resampler=stratified"]),
     ("S-S residual", ["env=hall", "estimator.resampler=residual"]),
     ("S-S multinomial", ["env=brick", "estimator.resampler=multinomial"]),
-    ("policy-S", ["env=enclosed", "pursuer=policy", f"pursuer.path={EXAMPLES / 'cem_pursuer.npz'}"]),
+    (
+        "policy-S",
+        ["env=enclosed", "pursuer=policy", f"pursuer.path={EXAMPLES / 'cem_pursuer.npz'}"],
+    ),
     ("S-S decision 2 Hz", ["env=enclosed", "game.decision_hz=2"]),
     ("S-S pybullet segmentation", ["sim=pybullet", "detector=segmentation", "game.t_max=6"]),
     ("S-R pybullet vision", ["sim=pybullet", "detector=vision", "evader=random", "game.t_max=6"]),

@@ -10,21 +10,37 @@ from pathlib import Path
 
 import numpy as np
 
-
 STRATEGY = {"R": "random", "S": "smart"}
 
 
 def game(map_name: str, ratio: float, pairing: str, seed: int, rate: float) -> dict:
     """A finished-game record as pegame writes it (only the fields the report reads, and some)."""
     pursuer, evader = (STRATEGY.get(letter, letter.lower()) for letter in pairing.split("-"))
-    return {"kind": "game", "pairing": pairing, "pursuer": pursuer, "evader": evader,
-            "estimator": "last_seen", "detector": "oracle", "sim": "grid", "map": map_name,
-            "seed": seed, "speed_ratio": ratio, "t_max": 90.0, "tracking_rate": rate,
-            "visible_rate": rate}
+    return {
+        "kind": "game",
+        "pairing": pairing,
+        "pursuer": pursuer,
+        "evader": evader,
+        "estimator": "last_seen",
+        "detector": "oracle",
+        "sim": "grid",
+        "map": map_name,
+        "seed": seed,
+        "speed_ratio": ratio,
+        "t_max": 90.0,
+        "tracking_rate": rate,
+        "visible_rate": rate,
+    }
 
 
-def write_job(root: Path, name: str, records: list[dict], overrides: list[str] | None = None,
-              tail: str = "", summary: bool = True) -> Path:
+def write_job(
+    root: Path,
+    name: str,
+    records: list[dict],
+    overrides: list[str] | None = None,
+    tail: str = "",
+    summary: bool = True,
+) -> Path:
     """A job dir with .hydra/overrides.yaml and results.jsonl (``records``, a summary line
     unless ``summary`` is False, then ``tail`` verbatim)."""
     job = root / name
@@ -32,8 +48,14 @@ def write_job(root: Path, name: str, records: list[dict], overrides: list[str] |
     (job / ".hydra" / "overrides.yaml").write_text("".join(f"- {o}\n" for o in overrides or []))
     ok = [r for r in records if r["kind"] == "game"]
     if summary:
-        records = records + [{"kind": "summary", "games": len(ok), "failed": len(records) - len(ok),
-                              "tracking_rate_mean": None}]
+        records = records + [
+            {
+                "kind": "summary",
+                "games": len(ok),
+                "failed": len(records) - len(ok),
+                "tracking_rate_mean": None,
+            }
+        ]
     lines = "".join(json.dumps(r) + "\n" for r in records)
     (job / "results.jsonl").write_text(lines + tail)
     return job
@@ -41,8 +63,11 @@ def write_job(root: Path, name: str, records: list[dict], overrides: list[str] |
 
 def sweep_games(rates: dict[tuple[str, float, str], list[float]]) -> list[dict]:
     """Game records for {(map, ratio, pairing): rates}, seeds 0.. within each cell."""
-    return [game(m, r, p, seed, v) for (m, r, p), values in rates.items()
-            for seed, v in enumerate(values)]
+    return [
+        game(m, r, p, seed, v)
+        for (m, r, p), values in rates.items()
+        for seed, v in enumerate(values)
+    ]
 
 
 def separated(high: str, low: str, n: int = 12) -> dict:
@@ -56,9 +81,15 @@ def separated(high: str, low: str, n: int = 12) -> dict:
     return cells
 
 
-PROVENANCE = {"pegame": "0.3.0", "commit": "4f1c2d9e8a7b6c5d4e3f2a1b0c9d8e7f6a5b4c3d", "dirty": False,
-              "python": "3.12.3", "numpy": "2.1.3", "numba": "0.60.0",
-              "plugins": {"pegame-pybullet": "0.1.0", "pegame-vision": "0.1.0"}}
+PROVENANCE = {
+    "pegame": "0.3.0",
+    "commit": "4f1c2d9e8a7b6c5d4e3f2a1b0c9d8e7f6a5b4c3d",
+    "dirty": False,
+    "python": "3.12.3",
+    "numpy": "2.1.3",
+    "numba": "0.60.0",
+    "plugins": {"pegame-pybullet": "0.1.0", "pegame-vision": "0.1.0"},
+}
 
 
 def job_config(**settings) -> dict:
@@ -87,31 +118,57 @@ def job_config(**settings) -> dict:
     return config
 
 
-def config_game(seed: int, rate: float, overrides: tuple[str, ...] = (),
-                provenance: dict | None = PROVENANCE, kind: str = "game", **settings) -> dict:
+def config_game(
+    seed: int,
+    rate: float,
+    overrides: tuple[str, ...] = (),
+    provenance: dict | None = PROVENANCE,
+    kind: str = "game",
+    **settings,
+) -> dict:
     """A game (or failed) line of the contract: today's fields plus config, config_hash,
     overrides and provenance."""
     config = job_config(**settings)
     pursuer, evader = config["pursuer"]["name"], config["evader"]["name"]
-    line = {"kind": kind, "seed": seed, "pairing": f"{pursuer[0].upper()}-{evader[0].upper()}",
-            "map": config["env"]["name"], "speed_ratio": config["game"]["speed_ratio"],
-            "config": config,
-            "config_hash": hashlib.sha256(json.dumps(config, sort_keys=True,
-                                                     separators=(",", ":")).encode()).hexdigest(),
-            "overrides": list(overrides), "provenance": provenance}
+    line = {
+        "kind": kind,
+        "seed": seed,
+        "pairing": f"{pursuer[0].upper()}-{evader[0].upper()}",
+        "map": config["env"]["name"],
+        "speed_ratio": config["game"]["speed_ratio"],
+        "config": config,
+        "config_hash": hashlib.sha256(
+            json.dumps(config, sort_keys=True, separators=(",", ":")).encode()
+        ).hexdigest(),
+        "overrides": list(overrides),
+        "provenance": provenance,
+    }
     if kind == "failed":
         return {**line, "error": "RuntimeError: boom", "traceback_file": f"failed_{seed}.txt"}
-    return {**line, "pursuer": pursuer, "evader": evader, "estimator": config["estimator"]["name"],
-            "detector": config["detector"]["name"], "sim": config["sim"]["name"],
-            "t_max": config["game"]["t_max"], "control_hz": 10.0, "decision_hz": 1.0,
-            "tracking_rate": rate, "visible_rate": rate}
+    return {
+        **line,
+        "pursuer": pursuer,
+        "evader": evader,
+        "estimator": config["estimator"]["name"],
+        "detector": config["detector"]["name"],
+        "sim": config["sim"]["name"],
+        "t_max": config["game"]["t_max"],
+        "control_hz": 10.0,
+        "decision_hz": 1.0,
+        "tracking_rate": rate,
+        "visible_rate": rate,
+    }
 
 
 def config_job(root: Path, name: str, seeds: range, rates: list[float], **settings) -> Path:
     """A job of the games ``seeds`` with ``rates``, all of one configuration."""
     overrides = [f"{k}={v}" for k, v in settings.items()]
-    return write_job(root, name, [config_game(s, r, tuple(overrides), **settings)
-                                  for s, r in zip(seeds, rates)], overrides)
+    return write_job(
+        root,
+        name,
+        [config_game(s, r, tuple(overrides), **settings) for s, r in zip(seeds, rates)],
+        overrides,
+    )
 
 
 def table_rows(md: str) -> list[list[str]]:

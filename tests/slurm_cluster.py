@@ -159,7 +159,7 @@ PartitionName={partition} Nodes={node} Default=YES MaxTime=INFINITE State=UP
 
 
 def _start(cluster: SlurmCluster, name: str, *command: str) -> None:
-    log = open(cluster.root / f"{name}.out", "wb")  # noqa: SIM115 - owned by the child
+    log = open(cluster.root / f"{name}.out", "wb")
     cluster.processes[name] = subprocess.Popen(
         command, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=cluster.env
     )

@@ -25,7 +25,11 @@ def run_app(tmp_path: Path, *overrides: str, name: str = "run") -> subprocess.Co
     overrides = tuple(o for o in overrides if o != "-m")
     return subprocess.run(
         [sys.executable, "-m", "pegame", *flags, f"hydra.run.dir={tmp_path / name}", *overrides],
-        cwd=tmp_path, capture_output=True, text=True, env=env, timeout=300,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
     )
 
 
@@ -40,7 +44,9 @@ def test_one_game_writes_config_result_trajectory_and_log(tmp_path):
     assert 0.0 <= result["tracking_rate"] <= result["visible_rate"] + 1e-9 <= 1.0 + 1e-9
     rows = list(csv.DictReader((out / "trajectory.csv").open()))
     assert len(rows) == result["ticks"] == 80
-    assert result["tracking_rate"] == pytest.approx(np.mean([int(r["detected"]) for r in rows]), abs=1e-6)
+    assert result["tracking_rate"] == pytest.approx(
+        np.mean([int(r["detected"]) for r in rows]), abs=1e-6
+    )
     assert "R-R" in proc.stdout and "hall" in proc.stdout and "tracking rate" in proc.stdout
 
 
@@ -52,7 +58,9 @@ def test_same_seed_gives_byte_identical_files(tmp_path):
         assert (tmp_path / "a" / file).read_bytes() == (tmp_path / "b" / file).read_bytes()
     other = run_app(tmp_path, *FAST, "env=enclosed", "game.seed=8", name="c")
     assert other.returncode == 0
-    assert (tmp_path / "c" / "trajectory.csv").read_bytes() != (tmp_path / "a" / "trajectory.csv").read_bytes()
+    assert (tmp_path / "c" / "trajectory.csv").read_bytes() != (
+        tmp_path / "a" / "trajectory.csv"
+    ).read_bytes()
 
 
 def test_any_ros_map_by_absolute_path(tmp_path):
@@ -65,7 +73,7 @@ def test_any_ros_map_by_absolute_path(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "overrides, expected",
+    ("overrides", "expected"),
     [
         (["pursuer=smrt"], "Unknown pursuer 'smrt'. Did you mean 'smart'?"),
         (["-m", "evader=smart,smrat"], "Unknown evader 'smrat'. Did you mean 'smart'?"),
@@ -111,7 +119,9 @@ def lines(path: Path) -> list[dict]:
 
 def test_a_game_that_fails_exits_1_and_the_others_are_written(tmp_path):
     # a 1e-5 rad camera finds a spawn for seeds 0-5 but not for seed 6
-    proc = run_app(tmp_path, *FAST, "env=enclosed", "camera.fov=1e-5", "game.seed=5", "game.trials=3")
+    proc = run_app(
+        tmp_path, *FAST, "env=enclosed", "camera.fov=1e-5", "game.seed=5", "game.trials=3"
+    )
     assert proc.returncode == 1, proc.stderr
     kinds = [(e["kind"], e.get("seed")) for e in lines(tmp_path / "run" / "results.jsonl")]
     assert kinds == [("game", 5), ("failed", 6), ("game", 7), ("summary", None)]
@@ -120,22 +130,42 @@ def test_a_game_that_fails_exits_1_and_the_others_are_written(tmp_path):
 
 @pytest.mark.parametrize("launcher", ["joblib", "basic"])
 def test_a_sweep_whose_games_all_fail_exits_1(tmp_path, launcher):
-    proc = run_app(tmp_path, "-m", *FAST, "env=enclosed", "camera.fov=1e-5", "game.seed=6",
-                   "pursuer=random", "evader=random,smart", f"hydra/launcher={launcher}",
-                   f"hydra.sweep.dir={tmp_path / 'sweep'}")
+    proc = run_app(
+        tmp_path,
+        "-m",
+        *FAST,
+        "env=enclosed",
+        "camera.fov=1e-5",
+        "game.seed=6",
+        "pursuer=random",
+        "evader=random,smart",
+        f"hydra/launcher={launcher}",
+        f"hydra.sweep.dir={tmp_path / 'sweep'}",
+    )
     assert proc.returncode == 1, proc.stderr
     for path in sorted((tmp_path / "sweep").glob("*/results.jsonl")):
         assert [e["kind"] for e in lines(path)] == ["failed", "summary"]
 
 
 def test_one_bad_cell_of_a_sweep_is_reported_and_the_others_run(tmp_path):
-    proc = run_app(tmp_path, "-m", *FAST, "env=hall", "game.speed_ratio=0,1",
-                   f"hydra.sweep.dir={tmp_path / 'sweep'}")
+    proc = run_app(
+        tmp_path,
+        "-m",
+        *FAST,
+        "env=hall",
+        "game.speed_ratio=0,1",
+        f"hydra.sweep.dir={tmp_path / 'sweep'}",
+    )
     assert proc.returncode == 2, proc.stderr
     assert "Traceback" not in proc.stderr
     bad, good = (lines(tmp_path / "sweep" / cell / "results.jsonl") for cell in ("0", "1"))
-    assert bad == [{"kind": "invalid", "error": bad[0]["error"],
-                    "overrides": [*FAST, "env=hall", "game.speed_ratio=0"]}]
+    assert bad == [
+        {
+            "kind": "invalid",
+            "error": bad[0]["error"],
+            "overrides": [*FAST, "env=hall", "game.speed_ratio=0"],
+        }
+    ]
     assert "'game.speed_ratio'" in bad[0]["error"]
     assert [e["kind"] for e in good] == ["game", "summary"]
     assert (tmp_path / "sweep" / "table1.md").exists()  # the report ran
@@ -151,12 +181,29 @@ def test_overrides_are_recorded_with_every_game(tmp_path):
 
 def test_resuming_a_sweep_with_other_cells_is_an_error_naming_the_keys(tmp_path):
     sweep = f"hydra.sweep.dir={tmp_path / 'sweep'}"
-    first = run_app(tmp_path, "-m", *FAST, "pursuer=random", "evader=random", "game.trials=2",
-                    "env=enclosed,brick", sweep)
+    first = run_app(
+        tmp_path,
+        "-m",
+        *FAST,
+        "pursuer=random",
+        "evader=random",
+        "game.trials=2",
+        "env=enclosed,brick",
+        sweep,
+    )
     assert first.returncode == 0, first.stderr
     before = {p: p.read_bytes() for p in (tmp_path / "sweep").glob("*/results.jsonl")}
-    again = run_app(tmp_path, "-m", *FAST, "pursuer=random", "evader=random", "game.trials=2",
-                    "env=brick,hall", "resume=true", sweep)
+    again = run_app(
+        tmp_path,
+        "-m",
+        *FAST,
+        "pursuer=random",
+        "evader=random",
+        "game.trials=2",
+        "env=brick,hall",
+        "resume=true",
+        sweep,
+    )
     assert again.returncode == 2
     assert "holds games of another config" in again.stderr and "env.name" in again.stderr
     assert {p: p.read_bytes() for p in (tmp_path / "sweep").glob("*/results.jsonl")} == before

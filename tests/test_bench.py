@@ -19,10 +19,21 @@ def test_decision_benchmarks_time_each_part_on_a_paper_map():
 
 def test_report_text_shows_missing_figures_as_dashes():
     report = {"machine": machine(), "jit_warmup_s": 1.0, "maps": {}, "sim_steps_per_s": 1000.0}
-    report.update(dict.fromkeys((
-        "rr_games_per_s", "ss_games_per_s", "recorder_overhead", "rrd_mb_per_game",
-        "env_steps_per_s", "pybullet_rtf", "vision_precision", "vision_recall",
-        "large_map_decision_ms", "large_map_peak_mb",
-    )))
+    report.update(
+        dict.fromkeys(
+            (
+                "rr_games_per_s",
+                "ss_games_per_s",
+                "recorder_overhead",
+                "rrd_mb_per_game",
+                "env_steps_per_s",
+                "pybullet_rtf",
+                "vision_precision",
+                "vision_recall",
+                "large_map_decision_ms",
+                "large_map_peak_mb",
+            )
+        )
+    )
     text = format_report(report)
     assert "machine:" in text and "S-S -" in text and "recorder: +-% game time" in text

@@ -9,11 +9,11 @@ import pytest
 from omegaconf import OmegaConf
 
 from pegame import registry
-from pegame.types import Camera
 from pegame.api import PLUGIN_KINDS
 from pegame.config import EnvConfig, GameConfig, Schema, check_known_keys, resolve_map_path, typed
 from pegame.errors import ConfigError
 from pegame.grid import load_map
+from pegame.types import Camera
 
 CONF = Path(str(files("pegame.conf")))
 
@@ -50,14 +50,19 @@ def test_default_config_validates(compose_config):
 
 
 @pytest.mark.parametrize(
-    "node, key, params, message",
+    ("node", "key", "params", "message"),
     [
         ("game", GameConfig, {"t_max": -1.0}, "'game.t_max'"),
         ("game", GameConfig, {"control_hz": 0.0}, "'game.control_hz'"),
         ("game", GameConfig, {"speed_ratio": -2.0}, "'game.speed_ratio'"),
         ("game", GameConfig, {"decision_hz": 20.0}, "'game.decision_hz'"),
         ("game", GameConfig, {"t_max": "abc"}, "'game.t_max'"),
-        ("game", GameConfig, {"t_maxx": 3}, "Unknown key 'game.t_maxx'. Did you mean 'game.t_max'?"),
+        (
+            "game",
+            GameConfig,
+            {"t_maxx": 3},
+            "Unknown key 'game.t_maxx'. Did you mean 'game.t_max'?",
+        ),
         ("game", GameConfig, {"t_maxx": 3}, "Allowed keys under 'game': seed, t_max"),
         ("game", GameConfig, {"seed": -1}, "'game.seed': -1"),
         ("game", GameConfig, {"t_max": 0.01}, "at least one control tick, 0.1 s"),
@@ -76,7 +81,7 @@ def test_bad_values_name_the_key_and_the_allowed_range(node, key, params, messag
 
 
 @pytest.mark.parametrize(
-    "group, option, params, key",
+    ("group", "option", "params", "key"),
     [
         ("evader", "random", {"v_max": 0.0}, "evader.v_max"),
         ("evader", "random", {"radius": -0.1}, "evader.radius"),
@@ -98,7 +103,7 @@ def test_decision_rates_that_divide_into_whole_ticks_are_accepted(decision_hz):
 
 
 @pytest.mark.parametrize(
-    "overrides, message",
+    ("overrides", "message"),
     [
         (["+foo=1"], "Unknown key 'foo'. Allowed top-level keys: game, camera, env, sim"),
         (["+gmae.t_max=5"], "Unknown key 'gmae'. Did you mean 'game'?"),

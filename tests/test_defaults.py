@@ -210,11 +210,6 @@ def node_comments(text: str, node: str) -> dict[str, str]:
     return yaml_comments(textwrap.dedent(block.group(1)))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="conf/config.yaml (the jobs branch's) words its body and game comments unlike "
-    "Pursuer.Config, Evader.Config and GameConfig; align them, then drop this mark",
-)
 @pytest.mark.parametrize(
     ("node", "schema"),
     [

@@ -19,7 +19,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from reference_games import DATA
 
 HERE = Path(__file__).resolve().parent
@@ -60,10 +59,19 @@ def belief_digest() -> str:
 def test_reference_games_are_the_same_with_kernels_for_a_generic_cpu(tmp_path):
     games = [g for g in json.loads(DATA.read_text()) if g["label"] in LABELS]
     assert len(games) == 2 * len(LABELS)
-    env = {**os.environ, "NUMBA_CPU_NAME": "generic", "NUMBA_CACHE_DIR": str(tmp_path / "numba"),
-           "NPY_DISABLE_CPU_FEATURES": NUMPY_SIMD}
-    done = subprocess.run([sys.executable, "-c", PLAY, str(HERE), json.dumps(games)], env=env,
-                          capture_output=True, text=True, timeout=600)
+    env = {
+        **os.environ,
+        "NUMBA_CPU_NAME": "generic",
+        "NUMBA_CACHE_DIR": str(tmp_path / "numba"),
+        "NPY_DISABLE_CPU_FEATURES": NUMPY_SIMD,
+    }
+    done = subprocess.run(
+        [sys.executable, "-c", PLAY, str(HERE), json.dumps(games)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert done.returncode == 0, done.stderr[-3000:]
     played, digest = json.loads(done.stdout.strip().splitlines()[-1])
     assert digest == belief_digest(), "the particle filter's numbers depend on the CPU"

@@ -7,17 +7,17 @@ import math
 import numpy as np
 import pytest
 
-from pegame.types import Pose
 from pegame.config import compose
 from pegame.envs.crop import LocalCrop, local_crop_reference
 from pegame.errors import ConfigError
 from pegame.grid import OccupancyGrid
+from pegame.types import Pose
 
 gymnasium = pytest.importorskip("gymnasium")
 pettingzoo_test = pytest.importorskip("pettingzoo.test")
 
-import pegame.envs  # noqa: E402  (registers the Gymnasium ids)
-from pegame.envs import parallel_env  # noqa: E402
+import pegame.envs
+from pegame.envs import parallel_env
 
 #: 3 s games on the smallest paper map keep every test short
 SHORT = ["env=enclosed", "game.t_max=3"]
@@ -59,14 +59,18 @@ def test_pettingzoo_parallel_api(par_env):
 
 
 def test_pettingzoo_parallel_seed():
-    pettingzoo_test.parallel_seed_test(lambda: parallel_env(overrides=SHORT, crop_cells=8), num_cycles=10)
+    pettingzoo_test.parallel_seed_test(
+        lambda: parallel_env(overrides=SHORT, crop_cells=8), num_cycles=10
+    )
 
 
 @pytest.mark.parametrize("env_id", IDS)
 def test_gymnasium_check_env(env_id):
     from gymnasium.utils.env_checker import check_env
 
-    env = gymnasium.make(env_id, overrides=[*SHORT, "game.t_max=1"], crop_cells=8, opponent="random")
+    env = gymnasium.make(
+        env_id, overrides=[*SHORT, "game.t_max=1"], crop_cells=8, opponent="random"
+    )
     check_env(env.unwrapped, skip_render_check=True)
     env.close()
 
@@ -108,7 +112,7 @@ def test_bad_seed_is_a_value_error(par_env, seed):
 
 
 @pytest.mark.parametrize(
-    "action, message",
+    ("action", "message"),
     [
         (np.array([np.nan, 0.0], np.float32), "finite"),
         (np.array([0.5, 0.2, 0.1], np.float32), "shape"),
@@ -136,7 +140,9 @@ def test_missing_or_unknown_agents_raise(par_env):
 def test_clip_actions_clips_finite_values_only():
     env = parallel_env(overrides=SHORT, crop_cells=4, clip_actions=True)
     clipped = rollout_with(env, np.array([3.0, -7.0], np.float32))
-    exact = rollout_with(parallel_env(overrides=SHORT, crop_cells=4), np.array([1.0, -1.0], np.float32))
+    exact = rollout_with(
+        parallel_env(overrides=SHORT, crop_cells=4), np.array([1.0, -1.0], np.float32)
+    )
     assert clipped == exact
     env.reset(seed=0)
     with pytest.raises(ValueError, match="finite"):
@@ -169,10 +175,14 @@ def test_zero_sum_rewards_count_detections_and_info_ends_with_the_metrics(par_en
     loop = par_env.game.loop
     summary = loop.metrics.summary()
     info = par_env.game.info()
-    assert info["metrics"] == summary and info["tracking_rate"] == pytest.approx(summary["tracking_rate"])
+    assert info["metrics"] == summary and info["tracking_rate"] == pytest.approx(
+        summary["tracking_rate"]
+    )
     # Rewards count detections at ticks 1..30, the measure ticks 0..29.
     first = loop.metrics.detected[0]
-    assert sum(r["pursuer"] for r in rewards) == 30 * summary["tracking_rate"] - first + (loop.detection is not None)
+    assert sum(r["pursuer"] for r in rewards) == 30 * summary["tracking_rate"] - first + (
+        loop.detection is not None
+    )
 
 
 def test_decision_period_holds_each_action_for_whole_ticks():
@@ -228,7 +238,10 @@ def test_observations_lie_in_their_space_and_start_with_a_detection(par_env):
     p = obs["pursuer"]
     assert p[4] == 1.0 and 0.0 < p[5] <= 1.0 and p[7] == 0.0  # seen now, in range, age 0
     layout = par_env.layouts["evader"]
-    assert set(layout) == {"pose", "pursuer", "relative", "crop"} and layout["crop"].stop == obs["evader"].size
+    assert (
+        set(layout) == {"pose", "pursuer", "relative", "crop"}
+        and layout["crop"].stop == obs["evader"].size
+    )
 
 
 def test_pose_features_are_normalised_by_the_map_extent(par_env):

@@ -13,14 +13,14 @@ import yaml
 
 from pegame import registry
 from pegame.api import Context
-from pegame.types import Body, BoundingBox, Camera, Detection, Pose
 from pegame.errors import ConfigError
-from pegame.visibility import MaskRegion, VisibilityRegion
 from pegame.estimators.kalman import KalmanEstimator
 from pegame.estimators.last_seen import LastSeen
 from pegame.estimators.particle_filter import ParticleFilter
 from pegame.estimators.resampling import RESAMPLERS
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid
+from pegame.types import Body, BoundingBox, Camera, Detection, Pose
+from pegame.visibility import MaskRegion, VisibilityRegion
 
 CONF = Path(__file__).resolve().parents[1] / "conf" / "estimator"
 DT = 0.1  # s, control period
@@ -83,7 +83,7 @@ def on_free(grid, particles):
 
 
 @pytest.mark.parametrize(
-    "cls, stem", [(ParticleFilter, "particle_filter"), (KalmanEstimator, "kalman")]
+    ("cls", "stem"), [(ParticleFilter, "particle_filter"), (KalmanEstimator, "kalman")]
 )
 def test_config_file_matches_config_class(cls, stem):
     doc = yaml.safe_load((CONF / f"{stem}.yaml").read_text())
@@ -95,7 +95,7 @@ def test_config_file_matches_config_class(cls, stem):
 
 
 @pytest.mark.parametrize(
-    "cls, key, value",
+    ("cls", "key", "value"),
     [
         (ParticleFilter, "n_particles", 0),
         (ParticleFilter, "rho", 1.5),
@@ -264,15 +264,20 @@ def run_side_by_side(grid, steps, seed, **params):
         found = None
         if step % 3:
             far = step % 29 == 0
-            found = detection(*rng.uniform([x0, y0], [x1, y1]) if far else rng.normal(start.position, 0.3))
-        yield fast.update(DT, PURSUER, found, fast_view), slow.update_reference(DT, PURSUER, found, slow_view)
+            found = detection(
+                *rng.uniform([x0, y0], [x1, y1]) if far else rng.normal(start.position, 0.3)
+            )
+        yield (
+            fast.update(DT, PURSUER, found, fast_view),
+            slow.update_reference(DT, PURSUER, found, slow_view),
+        )
         slow.particles, slow.weights = fast.particles, fast.weights
     assert fast.rng.bit_generator.state == slow.rng.bit_generator.state
 
 
 def assert_same_belief(fast, slow):
     """The fast path's belief equals the reference's to round-off (module docstring)."""
-    close = dict(rtol=1e-12, atol=1e-12)
+    close = {"rtol": 1e-12, "atol": 1e-12}
     np.testing.assert_allclose(fast.particles[:, :2], slow.particles[:, :2], **close)
     turn = np.angle(np.exp(1j * (fast.particles[:, 2] - slow.particles[:, 2])))
     np.testing.assert_allclose(turn, 0.0, **close)  # headings may wrap to -pi and pi
@@ -315,9 +320,9 @@ def test_motion_kernel_matches_the_reference_beyond_the_polynomial_range():
     slow.reset(PURSUER, start, view)
     headings = np.where(np.arange(400) % 2, 1e7, -3e9) + fast.particles[:, 2]
     fast.particles = slow.particles = np.column_stack([fast.particles[:, :2], headings])
-    assert_same_belief(fast.update(DT, PURSUER, start, view), slow.update_reference(DT, PURSUER, start, view))
-
-
+    assert_same_belief(
+        fast.update(DT, PURSUER, start, view), slow.update_reference(DT, PURSUER, start, view)
+    )
 
 
 def test_vanished_weights_reinitialise_outside_the_view(caplog):
@@ -447,7 +452,7 @@ def test_kalman_coasts_through_a_gap_of_misses():
     kf.reset(PURSUER, detection(*(truth[0] + noise[0])), None)
     for k in range(1, 35):
         tracked = kf.update(DT, PURSUER, detection(*(truth[k] + noise[k])), None)
-    for k in range(35, 45):
+    for _ in range(35, 45):
         belief = kf.update(DT, PURSUER, None, None)
     assert math.dist(belief.mean, truth[44]) < 0.2
     assert math.dist(belief.mean, tracked.mean) > 0.3  # it moved along the track

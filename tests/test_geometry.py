@@ -8,9 +8,8 @@ import numpy as np
 import pytest
 from scipy.ndimage import binary_dilation
 
-from pegame.types import Camera, Pose
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, point_cell
-from pegame.types import Region
+from pegame.types import Camera, Pose, Region
 from pegame.visibility import (
     MaskRegion,
     VisibilityRegion,
@@ -166,7 +165,9 @@ def test_region_over_a_block_equals_the_whole_mask_there(seed):
     height, width = rng.integers(20, 70, 2)
     resolution = float(rng.choice([0.05, 0.1]))
     yaw = 0.0 if seed % 2 else float(rng.uniform(-math.pi, math.pi))
-    grid = random_grid(rng, height, width, resolution, (rng.uniform(-3, 3), rng.uniform(-3, 3), yaw))
+    grid = random_grid(
+        rng, height, width, resolution, (rng.uniform(-3, 3), rng.uniform(-3, 3), yaw)
+    )
     partial = 0
     for _ in range(60):
         camera, pose = random_camera(rng), random_free_pose(rng, grid)
@@ -181,8 +182,10 @@ def test_region_over_a_block_equals_the_whole_mask_there(seed):
     assert partial > 20  # most blocks needed only part of the region
 
 
-@pytest.mark.parametrize("theta", [math.pi, -math.pi, math.nextafter(math.pi, 0.0),
-                                   math.nextafter(-math.pi, 0.0), 3 * math.pi])
+@pytest.mark.parametrize(
+    "theta",
+    [math.pi, -math.pi, math.nextafter(math.pi, 0.0), math.nextafter(-math.pi, 0.0), 3 * math.pi],
+)
 def test_region_over_a_block_is_exact_where_bearings_wrap_at_pi(theta):
     # The rays reaching a block are found from bearings wrapped to (-pi, pi] (the one angle
     # wrap of pegame.trig); a camera looking along -x at blocks around that bearing puts

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from pegame.api import Context
-from pegame.types import Body, Camera, Pose, Velocity
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from pegame.navigation import inflate
 from pegame.sims.grid import GridSimulator, _sweep, _sweep_reference, saturate, unicycle
+from pegame.types import Body, Camera, Pose, Velocity
 
 PURSUER = Body(radius=0.2, v_max=0.5, w_max=1.8)
 EVADER = Body(radius=0.25, v_max=0.5, w_max=1.8)

@@ -6,20 +6,32 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from report_fixtures import separated, sweep_games, write_job
 from scipy.stats import mannwhitneyu
 
 from pegame import report
 from pegame.config import compose
 from pegame.game import Game
-from report_fixtures import separated, sweep_games, write_job
 
 SEEDS = range(8)
 
 
 def tracking_rates(pursuer: str, tmp_path) -> list[float]:
     return [
-        Game(compose([f"pursuer={pursuer}", "evader=random", "env=enclosed", "recorder=none",
-                      "game.t_max=30", f"game.seed={seed}"])).play(tmp_path).result["tracking_rate"]
+        Game(
+            compose(
+                [
+                    f"pursuer={pursuer}",
+                    "evader=random",
+                    "env=enclosed",
+                    "recorder=none",
+                    "game.t_max=30",
+                    f"game.seed={seed}",
+                ]
+            )
+        )
+        .play(tmp_path)
+        .result["tracking_rate"]
         for seed in SEEDS
     ]
 
@@ -40,8 +52,13 @@ def test_h1_holds_when_smart_pursuer_is_better_and_fails_otherwise(tmp_path):
     cells = separated("S-R", "R-R")
     cells[("enclosed", 1.0, "S-R")] = [0.7, 0.8]  # no R-R here: not tested
     h1 = report.hypotheses(cells)[0]
-    assert h1["summary"] == {"verdict": "holds", "k": 4, "n": 4, "untested": 1,
-                             "text": "holds (in 4 of 4 cells)"}
+    assert h1["summary"] == {
+        "verdict": "holds",
+        "k": 4,
+        "n": 4,
+        "untested": 1,
+        "text": "holds (in 4 of 4 cells)",
+    }
     assert all(row["p_holm"] <= report.ALPHA for row in h1["rows"] if row["p"] is not None)
     h1 = report.hypotheses(separated("R-R", "S-R"))[0]
     assert h1["summary"]["verdict"] == "fails" and h1["summary"]["k"] == 0
@@ -56,7 +73,10 @@ def test_h1_holds_when_smart_pursuer_is_better_and_fails_otherwise(tmp_path):
 
 def test_h2_tests_the_slow_ratio_and_shows_the_rate_at_equal_speed():
     h2 = report.hypotheses(separated("S-R", "R-R"))[1]
-    assert [(row["map"], row["speed_ratio"]) for row in h2["rows"]] == [("hall", 0.5), ("brick", 0.5)]
+    assert [(row["map"], row["speed_ratio"]) for row in h2["rows"]] == [
+        ("hall", 0.5),
+        ("brick", 0.5),
+    ]
     assert h2["summary"]["verdict"] == "holds"
     assert h2["rows"][0]["x_stats_at_1"]["n"] == 12
     only_equal = {("hall", 1.0, "S-R"): [0.8], ("hall", 1.0, "R-R"): [0.2]}
@@ -66,10 +86,12 @@ def test_h2_tests_the_slow_ratio_and_shows_the_rate_at_equal_speed():
 
 def test_h3_needs_smart_evader_tracked_less_but_above_45_percent():
     rng = np.random.default_rng(2)
-    cells = {("hall", 1.0, "S-R"): rng.uniform(0.8, 0.95, 15).tolist(),
-             ("hall", 1.0, "S-S"): rng.uniform(0.5, 0.7, 15).tolist(),
-             ("brick", 1.0, "S-R"): rng.uniform(0.8, 0.95, 15).tolist(),
-             ("brick", 1.0, "S-S"): rng.uniform(0.1, 0.3, 15).tolist()}
+    cells = {
+        ("hall", 1.0, "S-R"): rng.uniform(0.8, 0.95, 15).tolist(),
+        ("hall", 1.0, "S-S"): rng.uniform(0.5, 0.7, 15).tolist(),
+        ("brick", 1.0, "S-R"): rng.uniform(0.8, 0.95, 15).tolist(),
+        ("brick", 1.0, "S-S"): rng.uniform(0.1, 0.3, 15).tolist(),
+    }
     h3 = report.hypotheses(cells)[2]
     by_map = {row["map"]: row for row in h3["rows"]}
     assert by_map["hall"]["holds"] and by_map["hall"]["tracked_less"]

@@ -71,13 +71,20 @@ def test_resume_skips_stored_games_of_the_same_config(tmp_path):
     played = job.run_job(resumed, tmp_path).played
     assert [r["seed"] for r in played] == [2, 3]
     config = next(job.read_lines(tmp_path / "results.jsonl"))["config"]
-    assert job.stored_seeds(tmp_path / "results.jsonl", config) == {0, 1, 2, 3}  # the fragment stays alone
+    assert job.stored_seeds(tmp_path / "results.jsonl", config) == {
+        0,
+        1,
+        2,
+        3,
+    }  # the fragment stays alone
 
 
 def test_resume_into_a_directory_of_another_config_names_the_differing_keys(tmp_path):
     job.run_job(compose([*SHORT, "game.trials=2", *RANDOM]), tmp_path)
     before = (tmp_path / "results.jsonl").read_bytes()
-    other = compose(["game.t_max=4", "recorder=none", "env=brick", "game.trials=2", "resume=true", *RANDOM])
+    other = compose(
+        ["game.t_max=4", "recorder=none", "env=brick", "game.trials=2", "resume=true", *RANDOM]
+    )
     with pytest.raises(JobDirectoryError) as info:
         job.run_job(other, tmp_path)
     assert "env.map" in str(info.value) and "env.name" in str(info.value)
@@ -115,7 +122,14 @@ def test_a_failing_game_is_recorded_and_the_job_goes_on(tmp_path, monkeypatch):
 
 def test_a_spawn_error_for_one_seed_is_that_games_failure(tmp_path):
     # a 1e-5 rad camera finds a spawn for seeds 0-5 but not for seed 6
-    args = ["game.t_max=4", "recorder=none", "env=enclosed", "camera.fov=1e-5", "game.trials=8", *RANDOM]
+    args = [
+        "game.t_max=4",
+        "recorder=none",
+        "env=enclosed",
+        "camera.fov=1e-5",
+        "game.trials=8",
+        *RANDOM,
+    ]
     run = job.run_job(compose(args), tmp_path)
     entries = lines(tmp_path / "results.jsonl")
     failed = [e for e in entries if e["kind"] == "failed"]
@@ -132,16 +146,32 @@ def test_a_full_disk_is_one_error_naming_the_file_and_the_result_is_printed(tmp_
         job.run_job(compose([*SHORT, *RANDOM]), tmp_path)
     assert str(tmp_path / "results.jsonl") in str(info.value) and "No space left" in str(info.value)
     printed = capsys.readouterr().err.splitlines()
-    entry = json.loads(printed[printed.index(next(p for p in printed if "could not be written" in p)) + 1])
+    entry = json.loads(
+        printed[printed.index(next(p for p in printed if "could not be written" in p)) + 1]
+    )
     assert entry["kind"] == "game" and entry["pairing"] == "R-R" and "tracking_rate" in entry
 
 
 def run_sweep(tmp_path: Path, *overrides: str) -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items() if k != "HYDRA_FULL_ERROR"}
     return subprocess.run(
-        [sys.executable, "-m", "pegame", "-m", *SHORT, "game.trials=2", "pursuer=random,smart",
-         "evader=random,smart", f"hydra.sweep.dir={tmp_path / 'sweep'}", *overrides],
-        cwd=tmp_path, capture_output=True, text=True, env=env, timeout=600,
+        [
+            sys.executable,
+            "-m",
+            "pegame",
+            "-m",
+            *SHORT,
+            "game.trials=2",
+            "pursuer=random,smart",
+            "evader=random,smart",
+            f"hydra.sweep.dir={tmp_path / 'sweep'}",
+            *overrides,
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=600,
     )
 
 
@@ -167,15 +197,33 @@ def test_multirun_through_submitit_local(tmp_path):
 # --- interrupting a sweep -------------------------------------------------------------
 
 TRIALS = 50  # enough games that the sweep is still running when it is interrupted
-SWEEP = [*SHORT, f"game.trials={TRIALS}", "pursuer=random", "evader=random,smart", "hydra/launcher=joblib",
-         "hydra.launcher.n_jobs=2"]
+SWEEP = [
+    *SHORT,
+    f"game.trials={TRIALS}",
+    "pursuer=random",
+    "evader=random,smart",
+    "hydra/launcher=joblib",
+    "hydra.launcher.n_jobs=2",
+]
 
 
 def start_sweep(tmp_path: Path, *extra: str) -> subprocess.Popen:
     env = {k: v for k, v in os.environ.items() if k != "HYDRA_FULL_ERROR"}
     return subprocess.Popen(
-        [sys.executable, "-m", "pegame", "-m", *SWEEP, f"hydra.sweep.dir={tmp_path / 'sweep'}", *extra],
-        cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env, start_new_session=True,
+        [
+            sys.executable,
+            "-m",
+            "pegame",
+            "-m",
+            *SWEEP,
+            f"hydra.sweep.dir={tmp_path / 'sweep'}",
+            *extra,
+        ],
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        env=env,
+        start_new_session=True,
     )
 
 

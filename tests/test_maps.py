@@ -131,8 +131,9 @@ def test_scale_mode_transparent_pixels_are_unknown(tmp_path):
 
 def test_raw_mode(tmp_path):
     pixels = np.array([[0, 37, 100, 101, 255]])
-    np.testing.assert_array_equal(load_pixels(tmp_path, pixels, mode="raw").data,
-                                  [[0, 37, 100, -1, -1]])
+    np.testing.assert_array_equal(
+        load_pixels(tmp_path, pixels, mode="raw").data, [[0, 37, 100, -1, -1]]
+    )
 
 
 def test_raw_mode_negated(tmp_path):
@@ -179,8 +180,13 @@ def test_saved_files_follow_map_saver(tmp_path):
     save_map(grid, tmp_path / "m.yaml")
     meta = yaml.safe_load((tmp_path / "m.yaml").read_text())
     assert meta == {
-        "image": "m.pgm", "resolution": 0.05, "origin": [1.0, 2.0, 0.0], "negate": 0,
-        "occupied_thresh": 0.65, "free_thresh": 0.196, "mode": "trinary",
+        "image": "m.pgm",
+        "resolution": 0.05,
+        "origin": [1.0, 2.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+        "mode": "trinary",
     }
     raw = (tmp_path / "m.pgm").read_bytes()
     assert raw.startswith(b"P5") and raw.endswith(bytes([205, 254, 254, 0]))  # top row first
@@ -189,8 +195,9 @@ def test_saved_files_follow_map_saver(tmp_path):
 def test_save_thresholds_intermediate_values(tmp_path):
     grid = OccupancyGrid(np.array([[0, 1, 64, 65, 99, 100, -1]]), 0.05)
     save_map(grid, tmp_path / "m.yaml")
-    np.testing.assert_array_equal(load_map(tmp_path / "m.yaml").data,
-                                  [[0, -1, -1, 100, 100, 100, -1]])
+    np.testing.assert_array_equal(
+        load_map(tmp_path / "m.yaml").data, [[0, -1, -1, 100, 100, 100, -1]]
+    )
 
 
 def test_save_overwrites_existing_files(tmp_path):
@@ -201,7 +208,7 @@ def test_save_overwrites_existing_files(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "target, image_format", [("m.yaml", "jpg"), ("m.pgm", "pgm"), ("missing/m.yaml", "pgm")]
+    ("target", "image_format"), [("m.yaml", "jpg"), ("m.pgm", "pgm"), ("missing/m.yaml", "pgm")]
 )
 def test_save_errors(tmp_path, target, image_format):
     path = tmp_path / target
@@ -214,25 +221,31 @@ def test_save_writes_shared_files_atomically(tmp_path):
     # failed write leaves no temporary file behind.
     save_map(OccupancyGrid(np.zeros((2, 2)), 0.05), tmp_path / "ok.yaml")
     assert {(p.name, p.stat().st_mode & 0o777) for p in tmp_path.iterdir()} == {
-        ("ok.pgm", 0o644), ("ok.yaml", 0o644)
+        ("ok.pgm", 0o644),
+        ("ok.yaml", 0o644),
     }
     (tmp_path / "dir.yaml").mkdir()  # the YAML cannot replace a directory
     with pytest.raises(MapError, match="cannot write"):
         save_map(OccupancyGrid(np.zeros((2, 2)), 0.05), tmp_path / "dir.yaml")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["dir.pgm", "dir.yaml", "ok.pgm", "ok.yaml"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "dir.pgm",
+        "dir.yaml",
+        "ok.pgm",
+        "ok.yaml",
+    ]
 
 
 # --------------------------------------------------------------------------- frames
 
 
-@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-4.2, 7.1, 0.0), (1.3, -2.0, 0.6),
-                                    (0.5, 0.5, -2.9)])
+@pytest.mark.parametrize(
+    "origin", [(0.0, 0.0, 0.0), (-4.2, 7.1, 0.0), (1.3, -2.0, 0.6), (0.5, 0.5, -2.9)]
+)
 def test_cell_to_world_and_back(origin):
     grid = OccupancyGrid(np.zeros((40, 50)), 0.05, origin)
     rng = np.random.default_rng(3)
     rows, cols = rng.integers(-10, 60, size=(2, 200))
-    np.testing.assert_array_equal(grid.world_to_cell(*grid.cell_to_world(rows, cols)),
-                                  (rows, cols))
+    np.testing.assert_array_equal(grid.world_to_cell(*grid.cell_to_world(rows, cols)), (rows, cols))
     assert grid.world_to_cell(*grid.cell_to_world(3, 4)) == (3, 4)
 
 
@@ -263,6 +276,7 @@ def yaml_text(text: str):
         path = tmp_path / "m.yaml"
         path.write_text(text)
         return path
+
     return make
 
 
@@ -270,6 +284,7 @@ def yaml_keys(**keys):
     def make(tmp_path: Path) -> Path:
         write_p5(tmp_path / "m.pgm", PIXELS)
         return write_yaml(tmp_path / "m.yaml", **keys)
+
     return make
 
 
@@ -277,6 +292,7 @@ def image_bytes(suffix: str, data: bytes):
     def make(tmp_path: Path) -> Path:
         (tmp_path / f"m.{suffix}").write_bytes(data)
         return write_yaml(tmp_path / "m.yaml", image=f"m.{suffix}")
+
     return make
 
 
@@ -293,8 +309,10 @@ BAD_MAPS = {
     "yaml list": (yaml_text("- image\n- resolution\n"), "mapping"),
     "empty yaml": (yaml_text(""), "mapping"),
     "missing image": (yaml_text("resolution: 0.05\norigin: [0, 0, 0]\n"), "'image' is missing"),
-    "missing resolution": (yaml_text("image: m.pgm\norigin: [0, 0, 0]\n"),
-                           "'resolution' is missing"),
+    "missing resolution": (
+        yaml_text("image: m.pgm\norigin: [0, 0, 0]\n"),
+        "'resolution' is missing",
+    ),
     "missing origin": (yaml_text("image: m.pgm\nresolution: 0.05\n"), "'origin' is missing"),
     "image not a string": (yaml_keys(image=3), "'image'"),
     "empty image": (yaml_keys(image=""), "'image'"),
@@ -302,16 +320,19 @@ BAD_MAPS = {
     "resolution bool": (yaml_keys(resolution=True), "'resolution' must be a number"),
     "resolution zero": (yaml_keys(resolution=0), "'resolution' must be finite and > 0"),
     "resolution negative": (yaml_keys(resolution=-0.05), "'resolution' must be finite"),
-    "resolution nan": (yaml_text("image: m.pgm\nresolution: .nan\norigin: [0, 0, 0]\n"),
-                       "'resolution' must be finite"),
-    "resolution inf": (yaml_text("image: m.pgm\nresolution: .inf\norigin: [0, 0, 0]\n"),
-                       "'resolution' must be finite"),
+    "resolution nan": (
+        yaml_text("image: m.pgm\nresolution: .nan\norigin: [0, 0, 0]\n"),
+        "'resolution' must be finite",
+    ),
+    "resolution inf": (
+        yaml_text("image: m.pgm\nresolution: .inf\norigin: [0, 0, 0]\n"),
+        "'resolution' must be finite",
+    ),
     "origin two numbers": (yaml_keys(origin=[0, 0]), "'origin' must be 3 finite numbers"),
     "origin four numbers": (yaml_keys(origin=[0, 0, 0, 0]), "'origin'"),
     "origin string item": (yaml_keys(origin=[0, "a", 0]), "'origin'"),
     "origin scalar": (yaml_keys(origin=0.0), "'origin'"),
-    "origin nan": (yaml_text("image: m.pgm\nresolution: 0.05\norigin: [0, .nan, 0]\n"),
-                   "'origin'"),
+    "origin nan": (yaml_text("image: m.pgm\nresolution: 0.05\norigin: [0, .nan, 0]\n"), "'origin'"),
     "negate two": (yaml_keys(negate=2), "'negate'"),
     "negate string": (yaml_keys(negate="maybe"), "'negate'"),
     "occupied above one": (yaml_keys(occupied_thresh=1.5), "'occupied_thresh' must lie in"),
@@ -330,7 +351,7 @@ BAD_MAPS = {
 }
 
 
-@pytest.mark.parametrize("make, problem", BAD_MAPS.values(), ids=BAD_MAPS.keys())
+@pytest.mark.parametrize(("make", "problem"), BAD_MAPS.values(), ids=BAD_MAPS.keys())
 def test_bad_input_raises_map_error_naming_the_file(tmp_path, make, problem):
     path = make(tmp_path)
     with pytest.raises(MapError) as info:
@@ -374,7 +395,7 @@ def test_paper_map_outer_wall_is_closed_and_thick(paper_map):
 
 def test_paper_map_free_space_is_connected_for_the_robot(paper_map):
     k = math.ceil(ROBOT_RADIUS / paper_map.resolution)
-    yy, xx = np.mgrid[-k:k + 1, -k:k + 1]
+    yy, xx = np.mgrid[-k : k + 1, -k : k + 1]
     disc = np.hypot(xx, yy) <= ROBOT_RADIUS / paper_map.resolution
     reachable = ~ndimage.binary_dilation(paper_map.blocked, disc, border_value=1)
     _, regions = ndimage.label(reachable)

@@ -10,7 +10,7 @@ import weakref
 import numpy as np
 import pytest
 
-from pegame.types import STOP, Body, Pose
+from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from pegame.navigation import (
     LARGE_GRID_CELLS,
     LARGE_GRID_LANDMARKS,
@@ -21,7 +21,7 @@ from pegame.navigation import (
 )
 from pegame.navigation.follower import _follow, _follow_reference
 from pegame.navigation.search import astar_reference, distance_field_reference
-from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from pegame.types import STOP, Body, Pose
 
 SEEDS = [0, 1, 2, 3, 4]
 MOVES = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)]

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from pegame.api import Context
-from pegame.types import Body, Camera, Pose, SensorFrame
 from pegame.detectors.oracle import OracleDetector
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 from pegame.registry import make_config
+from pegame.types import Body, Camera, Pose, SensorFrame
 
 CAMERA = Camera()  # pi/3 FOV, 0.3-5 m, 640 x 480 px
 EVADER = Body(radius=0.25, v_max=0.5, w_max=1.8)

@@ -29,7 +29,9 @@ def test_visibility_outlines_match_their_reference_and_bound_the_region(origin):
     fast = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01)
     slow = visibility_outlines(grid, xs, ys, thetas, camera, 64, z=0.01, compiled=False)
     np.testing.assert_array_equal(fast, slow)
-    assert fast.shape == (60, 64 + NEAR_ARC_POINTS + 1, 3) and np.array_equal(fast[:, 0], fast[:, -1])
+    assert fast.shape == (60, 64 + NEAR_ARC_POINTS + 1, 3) and np.array_equal(
+        fast[:, 0], fast[:, -1]
+    )
     in_region = []
     for outline, x, y, theta in zip(fast, xs, ys, thetas):
         mask = visibility_region(grid, Pose(x, y, theta), camera)
@@ -57,6 +59,9 @@ def test_free_runs_never_jump_into_a_blocked_cell():
         v, u = r + rng.random(), c + rng.random()
         a = rng.uniform(-math.pi, math.pi)
         k = np.arange(int(runs[r, c]))
-        fr, fc = np.floor(v + k * math.sin(a)).astype(int), np.floor(u + k * math.cos(a)).astype(int)
+        fr, fc = (
+            np.floor(v + k * math.sin(a)).astype(int),
+            np.floor(u + k * math.cos(a)).astype(int),
+        )
         inside = (fr >= 0) & (fr < grid.height) & (fc >= 0) & (fc < grid.width)
         assert inside.all() and not grid.blocked[fr, fc].any()

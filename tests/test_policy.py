@@ -45,7 +45,9 @@ def policy_entry_points(monkeypatch):
         points = dict(found(group))
         if group in classes and "policy" not in points:
             cls = classes[group]
-            points["policy"] = EntryPoint("policy", f"{cls.__module__}:{cls.__name__}", registry.GROUPS[group])
+            points["policy"] = EntryPoint(
+                "policy", f"{cls.__module__}:{cls.__name__}", registry.GROUPS[group]
+            )
         return points
 
     monkeypatch.setattr(registry, "_entry_points", with_policy)
@@ -75,7 +77,9 @@ def trajectory(outcome) -> np.ndarray:
 
 @pytest.mark.parametrize("evader", ["smart", "random"])
 def test_a_policy_pursuer_plays_exactly_as_in_pursuit_env(evader):
-    outcome = game("pursuer=policy", "pursuer.path=test_policy:chase", f"evader={evader}").play("unused")
+    outcome = game("pursuer=policy", "pursuer.path=test_policy:chase", f"evader={evader}").play(
+        "unused"
+    )
     assert np.array_equal(trajectory(outcome), env_rollout("pegame/Pursuit-v0", chase, evader))
     assert outcome.result["pursuer"] == "policy"
 
@@ -90,7 +94,9 @@ def test_a_linear_policy_file_brings_its_observation_settings(tmp_path):
     weights = np.zeros((2, 8 + 16))
     weights[0, 5], weights[1, 6] = 4.0, 3.0
     path = tmp_path / "p.npz"
-    LinearPolicy(weights, np.array([-1.2, 0.0]), "pursuer", settings, decision_period=0.2).save(path)
+    LinearPolicy(weights, np.array([-1.2, 0.0]), "pursuer", settings, decision_period=0.2).save(
+        path
+    )
     loaded = load_policy(str(path), "pursuer")
     assert loaded.settings == settings and loaded.decision_period == 0.2
     assert np.array_equal(loaded.weights, weights)
@@ -109,7 +115,9 @@ def test_the_strategy_holds_its_action_for_the_decision_period():
         calls.append(obs)
         return np.zeros(2)
 
-    cfg = compose([*SHORT, "pursuer=policy", "pursuer.path=test_policy:chase", "pursuer.decision_period=0.5"])
+    cfg = compose(
+        [*SHORT, "pursuer=policy", "pursuer.path=test_policy:chase", "pursuer.decision_period=0.5"]
+    )
     pursuer = game_with_policy(cfg)
     pursuer.player.policy = counting
     for tick in range(10):
@@ -125,11 +133,13 @@ def observation_at(pursuer, tick):
     from pegame.api import PursuerObservation
     from pegame.types import EMPTY_BELIEF, Pose
 
-    return PursuerObservation(0.1 * tick, Pose(5.0, 5.0, 0.0), None, EMPTY_BELIEF, np.zeros((1, 1), bool))
+    return PursuerObservation(
+        0.1 * tick, Pose(5.0, 5.0, 0.0), None, EMPTY_BELIEF, np.zeros((1, 1), bool)
+    )
 
 
 @pytest.mark.parametrize(
-    "params, message",
+    ("params", "message"),
     [
         ({"path": "policy.txt"}, "'pursuer.path'"),
         ({"path": "x.npz", "crop_cells": 0}, "'pursuer.crop_cells'"),
@@ -148,7 +158,7 @@ def test_the_evader_has_no_belief_option():
 
 
 @pytest.mark.parametrize(
-    "path, message",
+    ("path", "message"),
     [
         ("", "Missing value for 'pursuer.path'"),
         ("missing.npz", "does not exist"),
@@ -177,7 +187,9 @@ def test_policy_files_are_checked(tmp_path):
 def test_a_nan_action_is_an_error_and_large_ones_are_clipped():
     with pytest.raises(ValueError, match="finite"):
         game("pursuer=policy", "pursuer.path=test_policy:broken").play("unused")
-    pursuer = game_with_policy(compose([*SHORT, "pursuer=policy", "pursuer.path=test_policy:chase"]))
+    pursuer = game_with_policy(
+        compose([*SHORT, "pursuer=policy", "pursuer.path=test_policy:chase"])
+    )
     pursuer.player.policy = lambda obs: np.array([10.0, -10.0])
     command = pursuer.control(observation_at(pursuer, 0))
     body = pursuer.context.pursuer

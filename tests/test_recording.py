@@ -19,6 +19,11 @@ import pytest
 import yaml
 
 from pegame.api import Context, Tick
+from pegame.figures import plot_trajectory
+from pegame.game import Game
+from pegame.grid import OccupancyGrid
+from pegame.recorders.rerun import RerunRecorder, recording_id
+from pegame.replay import find_recordings
 from pegame.types import (
     Belief,
     Body,
@@ -30,22 +35,32 @@ from pegame.types import (
     SensorFrame,
     Velocity,
 )
-from pegame.figures import plot_trajectory
-from pegame.game import Game
 from pegame.visibility import VisibilityRegion, fov_wedge
-from pegame.grid import OccupancyGrid
-from pegame.recorders.rerun import RerunRecorder, recording_id
-from pegame.replay import find_recordings
 
 SHORT = ["game.t_max=5", "env=hall"]
 TICKS = 50  # 5 s at the default 10 Hz
 PER_TICK = [
-    "/world/pursuer/pose", "/world/pursuer/heading", "/world/pursuer/fov",
-    "/world/pursuer/visible", "/world/evader/pose", "/world/evader/heading",
-    "/world/detection", "/world/belief/mean", "/camera/detection",
-    "/plots/tracking/detected", "/plots/tracking/rate", "/plots/distance/true",
+    "/world/pursuer/pose",
+    "/world/pursuer/heading",
+    "/world/pursuer/fov",
+    "/world/pursuer/visible",
+    "/world/evader/pose",
+    "/world/evader/heading",
+    "/world/detection",
+    "/world/belief/mean",
+    "/camera/detection",
+    "/plots/tracking/detected",
+    "/plots/tracking/rate",
+    "/plots/distance/true",
 ]
-STATIC = ["/world", "/world/map", "/camera/frame", "/config", "/__properties/config", "/__properties/result"]
+STATIC = [
+    "/world",
+    "/world/map",
+    "/camera/frame",
+    "/config",
+    "/__properties/config",
+    "/__properties/result",
+]
 
 
 def read_steps(path: Path) -> tuple[dict[str, list[int]], set[str], list]:
@@ -118,9 +133,11 @@ def test_fov_wedge_is_placed_at_the_pursuer_pose_every_step(played):
         if chunk.is_static:
             strips = np.array(batch.column("LineStrips3D:strips").to_pylist()[0][0])
         else:
-            for step, t, q in zip(batch.column("step").to_pylist(),
-                                  batch.column("Transform3D:translation").to_pylist(),
-                                  batch.column("Transform3D:quaternion").to_pylist()):
+            for step, t, q in zip(
+                batch.column("step").to_pylist(),
+                batch.column("Transform3D:translation").to_pylist(),
+                batch.column("Transform3D:quaternion").to_pylist(),
+            ):
                 moves[step] = (np.array(t[0]), np.array(q[0]))
     assert strips is not None and sorted(moves) == list(range(TICKS))
     for row in outcome.trajectory:
@@ -129,7 +146,9 @@ def test_fov_wedge_is_placed_at_the_pursuer_pose_every_step(played):
         angle = 2.0 * math.atan2(qz, qw)
         assert qx == qy == 0.0
         c, s = math.cos(angle), math.sin(angle)
-        placed = np.column_stack([tx + c * strips[:, 0] - s * strips[:, 1], ty + s * strips[:, 0] + c * strips[:, 1]])
+        placed = np.column_stack(
+            [tx + c * strips[:, 0] - s * strips[:, 1], ty + s * strips[:, 0] + c * strips[:, 1]]
+        )
         np.testing.assert_allclose(placed, fov_wedge(game.context.camera, pose, n=16), atol=1e-5)
 
 
@@ -141,10 +160,14 @@ def test_trajectories_are_chained_segments_through_the_agent_poses(played):
     for name in ("pursuer", "evader"):
         segments = {}
         for chunk in RrdReader(out_dir / "game.rrd").stream().to_chunks():
-            if chunk.entity_path == f"/world/{name}/trajectory" and not chunk.is_static:  # static: style
+            if (
+                chunk.entity_path == f"/world/{name}/trajectory" and not chunk.is_static
+            ):  # static: style
                 batch = chunk.to_record_batch()
-                for step, strips in zip(batch.column("step").to_pylist(),
-                                        batch.column("LineStrips3D:strips").to_pylist()):
+                for step, strips in zip(
+                    batch.column("step").to_pylist(),
+                    batch.column("LineStrips3D:strips").to_pylist(),
+                ):
                     segments[step] = np.array(strips[0])
         steps = sorted(segments)
         assert steps == [*range(0, TICKS, 5), TICKS - 1]
@@ -162,8 +185,13 @@ def test_config_and_result_are_recording_properties_with_their_types(played):
     for chunk in RrdReader(out_dir / "game.rrd").stream().to_chunks():
         if chunk.entity_path in ("/__properties/config", "/__properties/result"):
             batch = chunk.to_record_batch()
-            found.update({(chunk.entity_path, name): batch.column(name).to_pylist()[0][0]
-                          for name in batch.schema.names if name != "rerun.controls.RowId"})
+            found.update(
+                {
+                    (chunk.entity_path, name): batch.column(name).to_pylist()[0][0]
+                    for name in batch.schema.names
+                    if name != "rerun.controls.RowId"
+                }
+            )
     assert found[("/__properties/config", "game.seed")] == game.seed
     assert found[("/__properties/config", "camera.fov")] == pytest.approx(game.context.camera.fov)
     assert found[("/__properties/result", "pairing")] == outcome.result["pairing"]
@@ -190,8 +218,12 @@ def test_unwritable_output_dir_warns_and_the_game_goes_on(played, compose_config
 
 def rrd_verify(path: Path) -> subprocess.CompletedProcess:
     """``rerun rrd verify path``, with the rerun CLI of this Python's rerun-sdk."""
-    return subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(path)],
-                          capture_output=True, text=True, timeout=60)
+    return subprocess.run(
+        [sys.executable, "-m", "rerun", "rrd", "verify", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
 
 
 def failing_at_decision(game: Game, count: int, error: BaseException) -> None:
@@ -236,10 +268,17 @@ def test_a_failed_game_leaves_a_failed_recording_readable_up_to_its_failure(fail
     for chunk in RrdReader(path).stream().to_chunks():
         batch = chunk.to_record_batch()
         if chunk.entity_path == "/events":
-            events += zip(batch.column("TextLog:level").to_pylist(), batch.column("TextLog:text").to_pylist())
+            events += zip(
+                batch.column("TextLog:level").to_pylist(), batch.column("TextLog:text").to_pylist()
+            )
         elif chunk.entity_path == "/__properties/failure":
-            failure.update({name: batch.column(name).to_pylist()[0][0]
-                            for name in batch.schema.names if name != "rerun.controls.RowId"})
+            failure.update(
+                {
+                    name: batch.column(name).to_pylist()[0][0]
+                    for name in batch.schema.names
+                    if name != "rerun.controls.RowId"
+                }
+            )
     assert (["ERROR"], ["game failed after step 19: RuntimeError: pursuer broke"]) in events
     assert failure == {"error": "RuntimeError", "message": "pursuer broke", "step": 19}
 
@@ -250,7 +289,9 @@ def test_a_finished_game_supersedes_its_failed_recording(tmp_path):
         recorder = RerunRecorder(RerunRecorder.Config(), context, None)
         recorder.start(str(tmp_path), "game_3", {})
         names = sorted(p.name for p in tmp_path.iterdir())
-        assert names == (["game_3.rrd.partial"] if abort else ["game_3.failed.rrd", "game_3.rrd.partial"])
+        assert names == (
+            ["game_3.rrd.partial"] if abort else ["game_3.failed.rrd", "game_3.rrd.partial"]
+        )
         for tick in synthetic_ticks(context, 6):
             recorder.log(tick)
         if abort:
@@ -295,18 +336,39 @@ def synthetic_ticks(context: Context, count: int) -> list[Tick]:
             detection = Detection(BoundingBox(300, 200, 40, 90), 2.5, (evader.x, evader.y), 0.9)
         particles = np.column_stack([rng.normal(3.5, 0.3, (1000, 2)), rng.uniform(-3, 3, 1000)])
         weights = rng.random(1000)
-        belief = Belief((3.4, 4.1), particles=particles, weights=weights / weights.sum(), n_eff=700.0)
+        belief = Belief(
+            (3.4, 4.1), particles=particles, weights=weights / weights.sum(), n_eff=700.0
+        )
         decision = step // 5  # a new plan every 5 ticks, the same objects in between
         if decision not in plans:
             plans[decision] = (
-                Plan(goal=(2.0 + decision, 4.0), path=np.array([[1.0, 4.5], [2.0 + decision, 4.0]]),
-                     info={"mode": "track" if decision % 2 == 0 else "search"}),
-                Plan(goal=(4.0, 5.0), path=np.array([[3.5, 4.0], [4.0, 5.0]]),
-                     info={"candidates": np.array([[4.0, 5.0], [5.0, 3.0], [2.0 + decision, 6.0]])}),
+                Plan(
+                    goal=(2.0 + decision, 4.0),
+                    path=np.array([[1.0, 4.5], [2.0 + decision, 4.0]]),
+                    info={"mode": "track" if decision % 2 == 0 else "search"},
+                ),
+                Plan(
+                    goal=(4.0, 5.0),
+                    path=np.array([[3.5, 4.0], [4.0, 5.0]]),
+                    info={"candidates": np.array([[4.0, 5.0], [5.0, 3.0], [2.0 + decision, 6.0]])},
+                ),
             )
         visible = VisibilityRegion(context.grid, pursuer, context.camera)
-        ticks.append(Tick(step, 0.1 * step, pursuer, evader, SensorFrame(0.1 * step, pursuer), detection,
-                          belief, visible, detection is not None, (Velocity(), Velocity()), plans[decision]))
+        ticks.append(
+            Tick(
+                step,
+                0.1 * step,
+                pursuer,
+                evader,
+                SensorFrame(0.1 * step, pursuer),
+                detection,
+                belief,
+                visible,
+                detection is not None,
+                (Velocity(), Velocity()),
+                plans[decision],
+            )
+        )
     return ticks
 
 
@@ -320,7 +382,12 @@ def test_recorder_logs_particles_candidates_n_eff_and_events(tmp_path):
     recorder.finish({"tracking_rate": 0.8, "mean_estimation_error": None})
     steps, static, _ = read_steps(tmp_path / "game_7.rrd")
     every = list(range(23))
-    for entity in ("/world/belief/particles", "/plots/n_eff", "/plots/distance/estimate_error", "/world/detection"):
+    for entity in (
+        "/world/belief/particles",
+        "/plots/n_eff",
+        "/plots/distance/estimate_error",
+        "/world/detection",
+    ):
         assert steps[entity] == every, entity
     # a new plan every 5 ticks; candidates only then
     assert steps["/world/evader/candidates"] == [0, 5, 10, 15, 20]
@@ -369,8 +436,11 @@ def test_particles_are_subsampled_and_coloured_by_weight(tmp_path):
     recorder.log(tick)
     recorder.finish({})
     assert np.array_equal(tick.belief.particles, particles_before)
-    chunks = [c for c in RrdReader(tmp_path / "game.rrd").stream().to_chunks()
-              if c.entity_path == "/world/belief/particles" and not c.is_static]
+    chunks = [
+        c
+        for c in RrdReader(tmp_path / "game.rrd").stream().to_chunks()
+        if c.entity_path == "/world/belief/particles" and not c.is_static
+    ]
     batch = chunks[0].to_record_batch()
     positions = batch.column("Points3D:positions").to_pylist()[0]
     colors = batch.column("Points3D:colors").to_pylist()[0]
@@ -381,8 +451,12 @@ def test_particles_are_subsampled_and_coloured_by_weight(tmp_path):
 def test_recording_id_is_deterministic_per_place_and_config(tmp_path):
     config = {"game": {"seed": 3}}
     assert recording_id(tmp_path, "game", config) == recording_id(tmp_path, "game", dict(config))
-    assert recording_id(tmp_path, "game", config) != recording_id(tmp_path / "other", "game", config)
-    assert recording_id(tmp_path, "game", config) != recording_id(tmp_path, "game", {"game": {"seed": 4}})
+    assert recording_id(tmp_path, "game", config) != recording_id(
+        tmp_path / "other", "game", config
+    )
+    assert recording_id(tmp_path, "game", config) != recording_id(
+        tmp_path, "game", {"game": {"seed": 4}}
+    )
 
 
 def test_config_file_lists_every_field_with_its_default():
@@ -393,9 +467,14 @@ def test_config_file_lists_every_field_with_its_default():
 
 
 def test_importing_the_null_recorder_and_replay_does_not_import_rerun():
-    code = ("import sys, pegame.recorders, pegame.recorders.none, pegame.recorders.files, pegame.replay; "
-            "print('rerun' in sys.modules)")
-    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip() == "False"
+    code = (
+        "import sys, pegame.recorders, pegame.recorders.none, pegame.recorders.files, pegame.replay; "
+        "print('rerun' in sys.modules)"
+    )
+    assert (
+        subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip()
+        == "False"
+    )
 
 
 # ----------------------------------------------------------------------- figures
@@ -403,15 +482,27 @@ def test_importing_the_null_recorder_and_replay_does_not_import_rerun():
 
 def test_plot_trajectory_writes_a_png(played, tmp_path):
     game, outcome, _ = played
-    path = plot_trajectory(game.context.grid, outcome.trajectory, tmp_path / "trajectory.png",
-                           pairing=outcome.result["pairing"], tracking_rate=outcome.result["tracking_rate"])
+    path = plot_trajectory(
+        game.context.grid,
+        outcome.trajectory,
+        tmp_path / "trajectory.png",
+        pairing=outcome.result["pairing"],
+        tracking_rate=outcome.result["tracking_rate"],
+    )
     data = path.read_bytes()
     assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 10_000
-    assert not [p for p in tmp_path.iterdir() if p.name != "trajectory.png"], "no temporary file left"
+    assert not [p for p in tmp_path.iterdir() if p.name != "trajectory.png"], (
+        "no temporary file left"
+    )
 
 
 def test_plot_trajectory_takes_csv_text_and_a_rotated_map(tmp_path):
     grid = small_context().grid
-    rows = [[str(v) for v in (k, 0.1 * k, 1 + 0.1 * k, 4.5, 0.0, 3.5, 4 + math.sin(k), 1.0, 1, 1)] for k in range(20)]
-    path = plot_trajectory(grid, rows, tmp_path / "trajectory.png", title="S-R (smart vs random) on box: " * 3)
+    rows = [
+        [str(v) for v in (k, 0.1 * k, 1 + 0.1 * k, 4.5, 0.0, 3.5, 4 + math.sin(k), 1.0, 1, 1)]
+        for k in range(20)
+    ]
+    path = plot_trajectory(
+        grid, rows, tmp_path / "trajectory.png", title="S-R (smart vs random) on box: " * 3
+    )
     assert path.stat().st_size > 1000

@@ -17,7 +17,9 @@ def fake_points(monkeypatch):
     """Replace the pursuer registry by hand-made entry points."""
 
     def install(**values):
-        points = {name: EntryPoint(name, value, "pegame.pursuers") for name, value in values.items()}
+        points = {
+            name: EntryPoint(name, value, "pegame.pursuers") for name, value in values.items()
+        }
         monkeypatch.setattr(registry, "_entry_points", lambda group: points)
 
     return install
@@ -65,7 +67,9 @@ def test_class_that_is_not_the_interface_is_a_plugin_error_naming_the_methods(fa
     with pytest.raises(registry.PluginError) as info:
         registry.load("pursuer", "half")
     assert "does not implement pegame.api.Pursuer: missing control, decide" in str(info.value)
-    assert "pursuer plugin 'half'" in str(info.value) and "fake_plugins:HalfPursuer" in str(info.value)
+    assert "pursuer plugin 'half'" in str(info.value) and "fake_plugins:HalfPursuer" in str(
+        info.value
+    )
 
 
 class FakeDistribution:
@@ -79,8 +83,11 @@ def point(name, value, dist):
 
 
 def test_two_distributions_registering_one_name_warn_and_the_choice_is_stable():
-    points = [point("smart", "b_pkg:Smart", "pegame-b"), point("smart", "a_pkg:Smart", "pegame-a"),
-              point("random", "pegame.pursuers.random:RandomPursuer", "pegame")]
+    points = [
+        point("smart", "b_pkg:Smart", "pegame-b"),
+        point("smart", "a_pkg:Smart", "pegame-a"),
+        point("random", "pegame.pursuers.random:RandomPursuer", "pegame"),
+    ]
     with pytest.warns(RuntimeWarning) as record:
         unique = registry.unique_by_name(points)
     assert list(unique) == ["random", "smart"]
@@ -88,7 +95,9 @@ def test_two_distributions_registering_one_name_warn_and_the_choice_is_stable():
     with pytest.warns(RuntimeWarning):
         assert unique == registry.unique_by_name(reversed(points))  # independent of sys.path order
     text = str(record[0].message)
-    assert "'smart'" in text and "pegame-a (a_pkg:Smart)" in text and "pegame-b (b_pkg:Smart)" in text
+    assert (
+        "'smart'" in text and "pegame-a (a_pkg:Smart)" in text and "pegame-b (b_pkg:Smart)" in text
+    )
 
 
 def test_the_installed_plugins_have_no_duplicate_names(recwarn):

@@ -16,7 +16,8 @@ import pytest
 
 from pegame.config import compose
 from pegame.game import Game
-from pegame.replay import find_recordings, main as replay_main, viewer_command
+from pegame.replay import find_recordings, viewer_command
+from pegame.replay import main as replay_main
 
 SHORT = ["recorder=rerun", "game.t_max=3", "env=hall"]
 
@@ -41,8 +42,9 @@ KILLED_GAME = textwrap.dedent("""
 
 def rrd_verify(path: Path) -> int:
     """The exit status of ``rerun rrd verify path``."""
-    return subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(path)],
-                          capture_output=True, timeout=60).returncode
+    return subprocess.run(
+        [sys.executable, "-m", "rerun", "rrd", "verify", str(path)], capture_output=True, timeout=60
+    ).returncode
 
 
 @pytest.fixture(scope="module")
@@ -59,8 +61,12 @@ def run_dir(tmp_path_factory):
     with pytest.raises(RuntimeError):
         game.play(root / "job1", "game_1")
     script = KILLED_GAME.format(overrides=[*SHORT, "recorder.flush_every=10"])
-    proc = subprocess.run([sys.executable, "-c", script, str(root / "job2")], capture_output=True, text=True,
-                          timeout=300)
+    proc = subprocess.run(
+        [sys.executable, "-c", script, str(root / "job2")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert proc.returncode == -9, proc.stderr  # killed
     return root
 
@@ -104,11 +110,21 @@ def test_replay_opens_complete_and_failed_recordings_not_partial_ones(run_dir, m
 
 
 def test_replay_finds_recordings_recursively_sorted(tmp_path, capsys):
-    for name in ("job1/game_2.rrd", "job0/game_1.rrd", "job0/game_0.rrd", "job0/notes.txt", "job0/.rrd"):
+    for name in (
+        "job1/game_2.rrd",
+        "job0/game_1.rrd",
+        "job0/game_0.rrd",
+        "job0/notes.txt",
+        "job0/.rrd",
+    ):
         (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / name).write_bytes(b"x" * 1500)
     files = find_recordings(tmp_path)
-    assert [p.relative_to(tmp_path).as_posix() for p in files] == ["job0/game_0.rrd", "job0/game_1.rrd", "job1/game_2.rrd"]
+    assert [p.relative_to(tmp_path).as_posix() for p in files] == [
+        "job0/game_0.rrd",
+        "job0/game_1.rrd",
+        "job1/game_2.rrd",
+    ]
     assert viewer_command(files)[:3] == [sys.executable, "-m", "rerun"]
     assert replay_main([str(tmp_path), "--list"]) == 0
     lines = capsys.readouterr().out.splitlines()

@@ -13,9 +13,9 @@ import sys
 
 import numpy as np
 import pytest
+from report_fixtures import config_game, config_job, game, separated, sweep_games, write_job
 
 from pegame import report
-from report_fixtures import config_game, config_job, game, separated, sweep_games, write_job
 
 
 def test_mean_is_the_sample_mean_and_ci_contains_the_population_mean(tmp_path):
@@ -47,8 +47,12 @@ def test_bootstrap_ci_covers_the_population_mean_about_95_percent_of_the_time():
 
 
 def test_table_layout_orders_maps_ratios_and_pairings_like_the_paper(tmp_path):
-    cells = {(m, r, p): [0.5, 0.6] for m in ("office", "brick", "hall", "enclosed")
-             for r in (2.0, 0.5, 1.0) for p in ("X-Y", "S-S", "R-S", "R-R", "S-R")}
+    cells = {
+        (m, r, p): [0.5, 0.6]
+        for m in ("office", "brick", "hall", "enclosed")
+        for r in (2.0, 0.5, 1.0)
+        for p in ("X-Y", "S-S", "R-S", "R-R", "S-R")
+    }
     write_job(tmp_path, "0", sweep_games(cells))
     report.write_report(tmp_path, tmp_path / "out")
     out = tmp_path / "out"
@@ -56,13 +60,25 @@ def test_table_layout_orders_maps_ratios_and_pairings_like_the_paper(tmp_path):
     pairings = ["R-R", "S-R", "S-S", "R-S", "X-Y"]
     md = (out / "table1.md").read_text().splitlines()
     header = next(line for line in md if line.startswith("| v_p/v_e"))
-    assert header == "| " + " | ".join(["v_p/v_e"] + [f"{m} {p}" for m in maps for p in pairings]) + " |"
-    body = md[md.index(header) + 2:]
+    assert (
+        header
+        == "| " + " | ".join(["v_p/v_e"] + [f"{m} {p}" for m in maps for p in pairings]) + " |"
+    )
+    body = md[md.index(header) + 2 :]
     assert [line.split(" | ")[0] for line in body[:3]] == ["| 0.5", "| 1", "| 2"]
     assert "55.0% [50.0, 60.0] n=2" in body[0]
     rows = list(csv.DictReader((out / "table1.csv").open()))
-    assert list(rows[0]) == ["map", "speed_ratio", "pairing", "n", "mean", "ci_low", "ci_high",
-                             "median", "std"]
+    assert list(rows[0]) == [
+        "map",
+        "speed_ratio",
+        "pairing",
+        "n",
+        "mean",
+        "ci_low",
+        "ci_high",
+        "median",
+        "std",
+    ]
     expected = [(m, r, p) for m in maps for r in (0.5, 1.0, 2.0) for p in pairings]
     assert [(r["map"], float(r["speed_ratio"]), r["pairing"]) for r in rows] == expected
     assert float(rows[0]["mean"]) == pytest.approx(0.55)
@@ -79,9 +95,11 @@ def test_missing_job_is_listed_with_its_overrides(tmp_path):
     (tmp_path / "1" / ".hydra").mkdir(parents=True)
     (tmp_path / "1" / ".hydra" / "overrides.yaml").write_text("- env=brick\n- game.speed_ratio=2\n")
     result = report.write_report(tmp_path)
-    assert result["missing_jobs"] == [{"job": "1", "overrides": ["env=brick", "game.speed_ratio=2"]}]
+    assert result["missing_jobs"] == [
+        {"job": "1", "overrides": ["env=brick", "game.speed_ratio=2"]}
+    ]
     md = (tmp_path / "table1.md").read_text()
-    section = md[md.index("## Missing and failed"):]
+    section = md[md.index("## Missing and failed") :]
     assert "job 1: overrides env=brick game.speed_ratio=2" in section
 
 
@@ -89,7 +107,9 @@ def test_truncated_last_line_is_skipped_and_reported(tmp_path, caplog):
     records = [game("hall", 1.0, "S-R", s, 0.5 + s / 10) for s in range(3)]
     write_job(tmp_path, "0", records, tail='{"kind": "game", "pairing": "S-', summary=False)
     resumed = json.dumps(game("hall", 1.0, "S-R", 9, 0.9)) + "\n"
-    write_job(tmp_path, "1", [game("hall", 1.0, "S-R", 8, 0.8)], tail=resumed)  # killed after resume
+    write_job(
+        tmp_path, "1", [game("hall", 1.0, "S-R", 8, 0.8)], tail=resumed
+    )  # killed after resume
     with caplog.at_level(logging.WARNING, logger="pegame.report"):
         result = report.write_report(tmp_path)
     assert result["games"] == 5 and result["cells"][0]["n"] == 5
@@ -102,8 +122,12 @@ def test_truncated_last_line_is_skipped_and_reported(tmp_path, caplog):
 
 
 def test_records_of_unknown_kind_or_without_required_keys_are_skipped(tmp_path):
-    write_job(tmp_path, "0", [game("hall", 1.0, "S-R", 0, 0.5)],
-              tail='{"kind": "progress"}\n{"kind": "game", "map": "hall"}\n[1, 2]\n')
+    write_job(
+        tmp_path,
+        "0",
+        [game("hall", 1.0, "S-R", 0, 0.5)],
+        tail='{"kind": "progress"}\n{"kind": "game", "map": "hall"}\n[1, 2]\n',
+    )
     result = report.write_report(tmp_path)
     assert result["games"] == 1 and result["unfinished_jobs"] == []
     reasons = [s["reason"] for s in result["skipped_lines"]]
@@ -132,24 +156,53 @@ def test_figures_are_non_empty_png_and_svg(tmp_path):
 
 def test_cli_writes_the_report_into_out(tmp_path):
     write_job(tmp_path / "sweep", "0", sweep_games(separated("S-R", "R-R", n=5)))
-    proc = subprocess.run([sys.executable, "-m", "pegame.report", str(tmp_path / "sweep"),
-                           "--out", str(tmp_path / "out")],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pegame.report",
+            str(tmp_path / "sweep"),
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 0, proc.stderr
     assert "H1: holds" in proc.stdout
     names = {p.name for p in (tmp_path / "out").iterdir()}
-    assert {"table1.md", "table1.csv", "table1.tex", "hypotheses.md", "report.json",
-            "fig8_pairing.svg"} <= names
-    bad = subprocess.run([sys.executable, "-m", "pegame.report", str(tmp_path / "nowhere")],
-                         capture_output=True, text=True, timeout=120)
+    assert {
+        "table1.md",
+        "table1.csv",
+        "table1.tex",
+        "hypotheses.md",
+        "report.json",
+        "fig8_pairing.svg",
+    } <= names
+    bad = subprocess.run(
+        [sys.executable, "-m", "pegame.report", str(tmp_path / "nowhere")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert bad.returncode == 2 and "not a directory" in bad.stderr
 
 
-@pytest.mark.parametrize("field, value", [
-    ("seed", "seven"), ("tracking_rate", "high"), ("tracking_rate", 1.5), ("speed_ratio", True),
-    ("config", [1, 2]), ("config_hash", 7), ("overrides", "env=hall"), ("provenance", "0.3"),
-    ("map", 3),
-])
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("seed", "seven"),
+        ("tracking_rate", "high"),
+        ("tracking_rate", 1.5),
+        ("speed_ratio", True),
+        ("config", [1, 2]),
+        ("config_hash", 7),
+        ("overrides", "env=hall"),
+        ("provenance", "0.3"),
+        ("map", 3),
+    ],
+)
 def test_a_line_with_a_wrong_type_is_skipped_and_listed(tmp_path, field, value):
     bad = {**config_game(9, 0.5), field: value}
     write_job(tmp_path, "0", [config_game(0, 0.5), bad, config_game(1, 0.7)])
@@ -157,7 +210,10 @@ def test_a_line_with_a_wrong_type_is_skipped_and_listed(tmp_path, field, value):
     assert result["games"] == 2 and result["cells"][0]["n"] == 2
     (skipped,) = result["skipped_lines"]
     assert skipped["line"] == 2 and f"'{field}' is {value!r}" in skipped["reason"]
-    assert "0/results.jsonl line 2: game record with a wrong type" in (tmp_path / "table1.md").read_text()
+    assert (
+        "0/results.jsonl line 2: game record with a wrong type"
+        in (tmp_path / "table1.md").read_text()
+    )
 
 
 def test_invalid_cells_are_listed_and_the_others_reported(tmp_path):
@@ -165,8 +221,12 @@ def test_invalid_cells_are_listed_and_the_others_reported(tmp_path):
     job = tmp_path / "1"
     (job / ".hydra").mkdir(parents=True)
     error = "Invalid value for 'detector.miss_probability': 1.5. Allowed: a number in [0, 1)."
-    (job / "results.jsonl").write_text(json.dumps({
-        "kind": "invalid", "error": error, "overrides": ["detector.miss_probability=1.5"]}) + "\n")
+    (job / "results.jsonl").write_text(
+        json.dumps(
+            {"kind": "invalid", "error": error, "overrides": ["detector.miss_probability=1.5"]}
+        )
+        + "\n"
+    )
     result = report.write_report(tmp_path)
     assert result["games"] == 3 and [c["n"] for c in result["cells"]] == [3]
     (failed,) = result["failed_cells"]
@@ -182,9 +242,19 @@ def test_a_report_that_cannot_be_written_is_one_clear_error(tmp_path, monkeypatc
     (tmp_path / "file").write_text("not a directory")
     with pytest.raises(report.ReportError, match="Cannot write the report into"):
         report.write_report(tmp_path / "sweep", tmp_path / "file" / "out")
-    proc = subprocess.run([sys.executable, "-m", "pegame.report", str(tmp_path / "sweep"),
-                           "--out", str(tmp_path / "file" / "out")],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pegame.report",
+            str(tmp_path / "sweep"),
+            "--out",
+            str(tmp_path / "file" / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 2 and "error: Cannot write the report into" in proc.stderr
     assert "Traceback" not in proc.stderr
 

@@ -143,7 +143,7 @@ def test_systematic_round_off_edge_case(path, monkeypatch):
 
 def test_inversion_kernel_matches_searchsorted():
     rng = np.random.default_rng(29)
-    for trial in range(300):
+    for _trial in range(300):
         n = int(rng.integers(1, 400))
         weights = rng.random(n) ** 4
         weights[rng.random(n) < 0.3] = 0.0  # zero weights, leading and trailing too
@@ -184,8 +184,12 @@ def test_threshold_resamples_exactly_when_n_eff_is_below_rho_n(path):
         weights = random_weights(rng, n)
         n_eff = effective_sample_size(weights / weights.sum())
         assert 1.0 <= n_eff < n
-        for rho, expected in ((n_eff / n * (1 + 1e-9), True), (n_eff / n * (1 - 1e-9), False),
-                              (0.0, False), (1.0, True)):
+        for rho, expected in (
+            (n_eff / n * (1 + 1e-9), True),
+            (n_eff / n * (1 - 1e-9), False),
+            (0.0, False),
+            (1.0, True),
+        ):
             scheme = RESAMPLERS[str(rng.choice(list(RESAMPLERS)))]()
             seed = int(rng.integers(2**32))
             wrapped_rng = np.random.default_rng(seed)
@@ -196,7 +200,10 @@ def test_threshold_resamples_exactly_when_n_eff_is_below_rho_n(path):
             else:
                 assert drawn is None
                 # Nothing drawn: the Generator is where it was.
-                assert wrapped_rng.bit_generator.state == np.random.default_rng(seed).bit_generator.state
+                assert (
+                    wrapped_rng.bit_generator.state
+                    == np.random.default_rng(seed).bit_generator.state
+                )
 
 
 def test_threshold_takes_the_callers_n_eff():

@@ -13,14 +13,19 @@ import pytest
 from scipy.ndimage import distance_transform_edt
 
 from pegame.api import Context, EvaderObservation
-from pegame.types import Body, Camera, Pose
 from pegame.errors import ConfigError
-from pegame.evaders.escape import MAX_RECORDED_CANDIDATES, _grow, _sample_positions, disc_half_widths
+from pegame.evaders.escape import (
+    MAX_RECORDED_CANDIDATES,
+    _grow,
+    _sample_positions,
+    disc_half_widths,
+)
 from pegame.evaders.smart import SmartEvader
-from pegame.visibility import VisibilityRegion, visibility_region
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid, load_map
 from pegame.navigation import Planner
 from pegame.registry import make_config
+from pegame.types import Body, Camera, Pose
+from pegame.visibility import VisibilityRegion, visibility_region
 
 MAPS_DIR = Path(__file__).resolve().parents[1] / "maps"
 
@@ -41,12 +46,19 @@ def walled_grid(height: int, width: int, blocks=()) -> OccupancyGrid:
     return OccupancyGrid(data, RES)
 
 
-def make_evader(grid, distance="euclidean", camera=CAMERA, evader=EVADER, pursuer=PURSUER, **params):
+def make_evader(
+    grid, distance="euclidean", camera=CAMERA, evader=EVADER, pursuer=PURSUER, **params
+):
     config = make_config(
         "evader",
         SmartEvader,
-        {"radius": evader.radius, "v_max": evader.v_max, "w_max": evader.w_max,
-         "distance": distance, **params},
+        {
+            "radius": evader.radius,
+            "v_max": evader.v_max,
+            "w_max": evader.w_max,
+            "distance": distance,
+            **params,
+        },
     )
     context = Context(grid, pursuer, evader, camera, control_dt=0.1, decision_dt=1.0)
     smart = SmartEvader(config, context, np.random.default_rng(0))
@@ -114,7 +126,10 @@ def brute_costs(grid, evader_pose, pursuer_pose, distance, margin=0.0) -> np.nda
     in_region = np.argwhere(visible)
     e_trav = Planner(grid, EVADER.radius).traversable
     p_trav = Planner(grid, PURSUER.radius).traversable
-    e_cell, p_cell = cell_of((evader_pose.x, evader_pose.y)), cell_of((pursuer_pose.x, pursuer_pose.y))
+    e_cell, p_cell = (
+        cell_of((evader_pose.x, evader_pose.y)),
+        cell_of((pursuer_pose.x, pursuer_pose.y)),
+    )
     reach = bfs_reachable(e_trav, e_cell)
     if distance == "geodesic":
         e_dist, p_dist = dijkstra(e_trav, e_cell), dijkstra(p_trav, p_cell)
@@ -123,7 +138,11 @@ def brute_costs(grid, evader_pose, pursuer_pose, distance, margin=0.0) -> np.nda
         for c in range(grid.width):
             if grid.data[r, c] != FREE or not reach[r, c] or visible[r, c]:
                 continue
-            if margin > 0 and len(in_region) and np.hypot(*(in_region - (r, c)).T).min() * RES <= margin:
+            if (
+                margin > 0
+                and len(in_region)
+                and np.hypot(*(in_region - (r, c)).T).min() * RES <= margin
+            ):
                 continue
             if distance == "euclidean":
                 x, y = centre(r, c)
@@ -196,7 +215,7 @@ def assert_same_escape(smart, me, pursuer):
 
 
 @pytest.mark.parametrize("distance", ["euclidean", "geodesic"])
-@pytest.mark.parametrize("margin, stride", [(0.0, 1), (0.15, 1), (0.3, 1), (0.3, 3)])
+@pytest.mark.parametrize(("margin", "stride"), [(0.0, 1), (0.15, 1), (0.3, 1), (0.3, 3)])
 def test_escape_kernels_match_the_numpy_reference(distance, margin, stride):
     for seed in range(25):
         # Small rooms, and larger ones where most tiles are out of view and skipped.
@@ -219,7 +238,7 @@ def test_the_games_region_gives_the_same_decisions(distance):
             if step == 1:
                 region.holds(np.arange(0, grid.height * grid.width, 7))  # as the estimator asks
             if step == 2:
-                region.mask  # already computed whole, as a recorder does
+                _ = region.mask  # already computed whole, as a recorder does
             mine = own.decide(EvaderObservation(float(step), me, p))
             given = told.decide(EvaderObservation(float(step), me, p, region))
             assert given.goal == mine.goal and np.array_equal(given.path, mine.path)
@@ -254,7 +273,9 @@ def test_escape_kernels_match_the_reference_on_a_paper_map(distance):
     for k in range(10 if distance == "euclidean" else 3):
         i, j = rng.integers(rows.size, size=2)
         pursuer = Pose(*grid.cell_to_world(rows[i], cols[i]), rng.uniform(-math.pi, math.pi))
-        in_rows, in_cols = np.nonzero(visibility_region(grid, pursuer, camera) & smart.planner.traversable)
+        in_rows, in_cols = np.nonzero(
+            visibility_region(grid, pursuer, camera) & smart.planner.traversable
+        )
         if k % 2 and in_rows.size:  # the evader in the region: the search has to go far
             i = rng.integers(in_rows.size)
             me = Pose(*grid.cell_to_world(in_rows[i], in_cols[i]), 0.0)
@@ -276,8 +297,14 @@ def test_grown_view_matches_the_distance_transform(resolution, margin):
         visible &= rng.random(visible.shape) < 0.9  # holes and ragged runs
         expected = distance_transform_edt(~visible) * resolution <= margin
         rows, cols = np.nonzero(visible)
-        window, top, left = _grow(visible, rows.min(), rows.max() + 1, cols.min(), cols.max() + 1,
-                                  disc_half_widths(margin, resolution))
+        window, top, left = _grow(
+            visible,
+            rows.min(),
+            rows.max() + 1,
+            cols.min(),
+            cols.max() + 1,
+            disc_half_widths(margin, resolution),
+        )
         grown = np.zeros_like(visible)
         grown[top : top + window.shape[0], left : left + window.shape[1]] = window
         np.testing.assert_array_equal(grown, expected)
@@ -332,8 +359,9 @@ def test_cells_the_pursuer_cannot_reach_are_ideal_with_geodesic_distances():
     pursuer, me = Pose(1.05, 0.85, 0.3), Pose(2.05, 1.05, 0.0)
     smart = make_evader(grid, "geodesic", evader=small, pursuer=big)
     plan = smart.decide(EvaderObservation(0.0, me, pursuer))
-    closet = Planner(grid, small.radius).reachable((me.x, me.y)) & ~Planner(grid, big.radius).reachable(
-        (pursuer.x, pursuer.y))
+    closet = Planner(grid, small.radius).reachable((me.x, me.y)) & ~Planner(
+        grid, big.radius
+    ).reachable((pursuer.x, pursuer.y))
     hidden = closet & ~visibility_region(grid, pursuer, CAMERA)
     assert plan.info["escape_cost"] == 0.0
     rows, cols = np.nonzero(hidden)
@@ -387,7 +415,9 @@ def test_evader_moves_toward_its_goal():
         cmd = smart.control(EvaderObservation(step * dt, pose, pursuer))
         assert abs(cmd.v) <= EVADER.v_max + 1e-9 and abs(cmd.w) <= EVADER.w_max + 1e-9
         theta = pose.theta + cmd.w * dt
-        pose = Pose(pose.x + cmd.v * math.cos(theta) * dt, pose.y + cmd.v * math.sin(theta) * dt, theta)
+        pose = Pose(
+            pose.x + cmd.v * math.cos(theta) * dt, pose.y + cmd.v * math.sin(theta) * dt, theta
+        )
         assert not grid.blocked[cell_of((pose.x, pose.y))]
     assert math.dist((pose.x, pose.y), plan.goal) < min(0.3, 0.5 * start_gap)
 
@@ -416,10 +446,12 @@ def test_candidate_stride_scores_every_kth_cell():
 
 
 @pytest.mark.parametrize(
-    "params, key",
-    [({"distance": "manhattan"}, "evader.distance"),
-     ({"candidate_stride": 0}, "evader.candidate_stride"),
-     ({"radius": -1.0}, "evader.radius")],
+    ("params", "key"),
+    [
+        ({"distance": "manhattan"}, "evader.distance"),
+        ({"candidate_stride": 0}, "evader.candidate_stride"),
+        ({"radius": -1.0}, "evader.radius"),
+    ],
 )
 def test_bad_config_names_the_key(params, key):
     with pytest.raises(ConfigError, match=key.replace(".", r"\.")):

@@ -13,7 +13,6 @@ import pytest
 from omegaconf import OmegaConf
 
 from pegame.api import Context, PursuerObservation
-from pegame.types import EMPTY_BELIEF, Belief, Body, BoundingBox, Camera, Detection, Pose, Velocity
 from pegame.errors import ConfigError
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 from pegame.navigation import inflate
@@ -26,6 +25,7 @@ from pegame.pursuers.smart import (
     _straight_clear_reference,
 )
 from pegame.registry import make_config
+from pegame.types import EMPTY_BELIEF, Belief, Body, BoundingBox, Camera, Detection, Pose, Velocity
 
 RES = 0.1  # m per cell
 V_MAX, W_MAX, RADIUS = 0.5, 1.8, 0.2
@@ -63,8 +63,11 @@ def observe(pose: Pose, detection: Detection | None = None, mean=None, time: flo
 def step(pose: Pose, cmd: Velocity, dt: float = 0.1) -> Pose:
     """Euler step of the unicycle, saturated to the pursuer's limits."""
     v, w = float(np.clip(cmd.v, -V_MAX, V_MAX)), float(np.clip(cmd.w, -W_MAX, W_MAX))
-    return Pose(pose.x + v * dt * math.cos(pose.theta), pose.y + v * dt * math.sin(pose.theta),
-                math.remainder(pose.theta + w * dt, 2 * math.pi))
+    return Pose(
+        pose.x + v * dt * math.cos(pose.theta),
+        pose.y + v * dt * math.sin(pose.theta),
+        math.remainder(pose.theta + w * dt, 2 * math.pi),
+    )
 
 
 CENTRE = Pose(3.0, 3.0, 0.0)  # the middle of the open grid, facing +x
@@ -74,7 +77,7 @@ CENTRE = Pose(3.0, 3.0, 0.0)  # the middle of the open grid, facing +x
 
 
 @pytest.mark.parametrize(
-    "center_x, sign", [(500.0, -1), (140.0, 1), (320.0, 0)], ids=["right", "left", "centred"]
+    ("center_x", "sign"), [(500.0, -1), (140.0, 1), (320.0, 0)], ids=["right", "left", "centred"]
 )
 def test_turns_toward_the_box(center_x, sign):
     pursuer = make_pursuer(open_grid())
@@ -257,7 +260,7 @@ def test_unreachable_estimate_scans_toward_it(caplog):
 
 
 @pytest.mark.parametrize(
-    "params, key",
+    ("params", "key"),
     [
         ({"standoff": 0.0}, "pursuer.standoff"),
         ({"k_w": -1.0}, "pursuer.k_w"),
@@ -272,7 +275,9 @@ def test_bad_config_names_the_key(params, key):
 
 
 def test_config_file_matches_the_defaults():
-    node = OmegaConf.to_container(OmegaConf.load(str(files("pegame.conf") / "pursuer" / "smart.yaml")))
+    node = OmegaConf.to_container(
+        OmegaConf.load(str(files("pegame.conf") / "pursuer" / "smart.yaml"))
+    )
     assert node.pop("name") == "smart"
     defaults = SmartPursuer.Config()
     own = {f.name for f in fields(defaults)} - {"radius", "w_max"}

@@ -9,7 +9,11 @@ import pytest
 from numba import njit
 
 from pegame.trig import (
-    MAX_ANGLE, sin_cos, wrap_angle_kernel, wrap_angles, wrap_angles_reference,
+    MAX_ANGLE,
+    sin_cos,
+    wrap_angle_kernel,
+    wrap_angles,
+    wrap_angles_reference,
 )
 from pegame.types import wrap_angle
 
@@ -37,8 +41,23 @@ def test_sin_cos_is_within_one_ulp_of_one_of_libm(limit):
 
 def wrap_test_angles():
     period = 2.0 * math.pi
-    edges = [0.0, -0.0, math.pi, -math.pi, period, -period, 2 * period, -2 * period,
-             3 * math.pi, -3 * math.pi, 1e300, -1e300, math.inf, -math.inf, math.nan]
+    edges = [
+        0.0,
+        -0.0,
+        math.pi,
+        -math.pi,
+        period,
+        -period,
+        2 * period,
+        -2 * period,
+        3 * math.pi,
+        -3 * math.pi,
+        1e300,
+        -1e300,
+        math.inf,
+        -math.inf,
+        math.nan,
+    ]
     edges += [np.nextafter(v, d) for v in edges[:10] for d in (math.inf, -math.inf)]
     return np.concatenate([edges, np.random.default_rng(30).uniform(-20.0, 20.0, 20000)])
 
@@ -69,14 +88,28 @@ def test_wraps_land_in_minus_pi_to_pi_and_agree_with_the_scalar_wrap_within_ulps
     assert np.max(gap) <= 4 * np.spacing(math.pi) * (1 + np.abs(angles).max() / math.pi)
 
 
-
 def test_exps_is_within_one_ulp_of_libm_and_zero_below_the_normal_range():
     from pegame.trig import EXP_MAX, EXP_NORMAL_MIN, exps
 
     rng = np.random.default_rng(41)
-    xs = np.concatenate([rng.uniform(EXP_NORMAL_MIN, EXP_MAX, 20000), rng.uniform(-2.0, 2.0, 20000),
-                         [0.0, -0.0, 1e-300, -1e-300, math.log(2.0), -math.log(2.0), 1.0, -1.0,
-                          EXP_NORMAL_MIN, EXP_MAX]])
+    xs = np.concatenate(
+        [
+            rng.uniform(EXP_NORMAL_MIN, EXP_MAX, 20000),
+            rng.uniform(-2.0, 2.0, 20000),
+            [
+                0.0,
+                -0.0,
+                1e-300,
+                -1e-300,
+                math.log(2.0),
+                -math.log(2.0),
+                1.0,
+                -1.0,
+                EXP_NORMAL_MIN,
+                EXP_MAX,
+            ],
+        ]
+    )
     for x, ours in zip(xs, exps(xs)):
         exact = math.exp(x)
         assert abs(ours - exact) <= math.ulp(exact), x

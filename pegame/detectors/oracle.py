@@ -18,8 +18,8 @@ import math
 from dataclasses import dataclass
 
 from pegame.api import Detector
-from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame.errors import require
+from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame.visibility import in_view
 
 
@@ -37,10 +37,18 @@ class OracleDetector(Detector):
 
         def __post_init__(self) -> None:
             for key in ("evader_height", "camera_height"):
-                require(getattr(self, key) > 0, f"detector.{key}", "a positive height in m", getattr(self, key))
+                require(
+                    getattr(self, key) > 0,
+                    f"detector.{key}",
+                    "a positive height in m",
+                    getattr(self, key),
+                )
             require(self.range_noise >= 0, "detector.range_noise", "a std >= 0 m", self.range_noise)
             require(
-                0 <= self.miss_probability <= 1, "detector.miss_probability", "[0, 1]", self.miss_probability
+                0 <= self.miss_probability <= 1,
+                "detector.miss_probability",
+                "[0, 1]",
+                self.miss_probability,
             )
 
     def detect(self, frame: SensorFrame) -> Detection | None:

@@ -26,7 +26,9 @@ def to_velocity(action, body: Body, clip: bool = False, who: str = "action") -> 
     except (TypeError, ValueError):
         raise ValueError(f"{who} must be 2 numbers (v, w) in [-1, 1], got {action!r}.") from None
     if shape != (2,):
-        raise ValueError(f"{who} must have shape (2,) (v, w) in [-1, 1], got shape {shape}: {action!r}.")
+        raise ValueError(
+            f"{who} must have shape (2,) (v, w) in [-1, 1], got shape {shape}: {action!r}."
+        )
     if not (math.isfinite(v) and math.isfinite(w)):
         raise ValueError(f"{who} must be finite, got {action!r}.")
     if not (-1.0 <= v <= 1.0 and -1.0 <= w <= 1.0):

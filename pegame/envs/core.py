@@ -31,7 +31,9 @@ from pegame.loop import TickLoop
 
 def check_seed(seed: int | None) -> int | None:
     """``seed`` if it is None or a non-negative integer, else ValueError."""
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
+    if seed is not None and (
+        isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0
+    ):
         raise ValueError(f"seed must be a non-negative integer or None, got {seed!r}.")
     return seed
 
@@ -118,7 +120,9 @@ class EnvGame:
 
     def _commands(self, actions: Mapping[str, object]) -> dict:
         if not isinstance(actions, Mapping):
-            raise ValueError(f"actions must map each agent in {list(self.roles)} to its action, got {actions!r}.")
+            raise ValueError(
+                f"actions must map each agent in {list(self.roles)} to its action, got {actions!r}."
+            )
         unknown = sorted(set(actions) - set(self.roles))
         missing = [role for role in self.roles if role not in actions]
         if unknown or missing:
@@ -127,7 +131,9 @@ class EnvGame:
                 f"missing {missing}, unexpected {unknown}."
             )
         return {
-            role: to_velocity(actions[role], self.bodies[role], self.settings.clip_actions, f"{role} action")
+            role: to_velocity(
+                actions[role], self.bodies[role], self.settings.clip_actions, f"{role} action"
+            )
             for role in self.roles
         }
 

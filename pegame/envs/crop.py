@@ -105,12 +105,23 @@ class LocalCrop:
         gx, gy, yaw = grid.origin
         self._origin = (gx, gy, math.cos(yaw), math.sin(yaw), yaw != 0.0, float(grid.resolution))
 
-    def __call__(self, x: float, y: float, theta: float, out: np.ndarray | None = None) -> np.ndarray:
+    def __call__(
+        self, x: float, y: float, theta: float, out: np.ndarray | None = None
+    ) -> np.ndarray:
         """Flat float32 (cells * cells,) crop around the map-frame pose (x m, y m, theta
         rad), row-major as in the module docstring; written into ``out`` when given (a
         float32 array of that size, e.g. a slice of an observation vector)."""
         if out is None:
             out = np.empty(self.size, dtype=np.float32)
-        _crop(self._pooled, self._off_x, self._off_y, float(x), float(y), math.cos(theta), math.sin(theta),
-              *self._origin, out)
+        _crop(
+            self._pooled,
+            self._off_x,
+            self._off_y,
+            float(x),
+            float(y),
+            math.cos(theta),
+            math.sin(theta),
+            *self._origin,
+            out,
+        )
         return out

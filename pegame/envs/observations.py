@@ -42,9 +42,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from pegame.api import Context, EvaderObservation, PursuerObservation
-from pegame.types import Belief, Detection, Pose
 from pegame.envs.crop import LocalCrop
 from pegame.errors import require
+from pegame.types import Belief, Detection, Pose
 
 #: s; detection ages are divided by this and capped at 1
 AGE_SCALE = 10.0
@@ -56,16 +56,22 @@ class ObservationSettings:
 
     crop_cells: int = 32  # cells per side of the local occupancy crop
     crop_resolution: float = 0.2  # m per crop cell
-    belief: bool = False  # append the pursuer's estimator summary (costs an estimator update per tick)
+    belief: bool = (
+        False  # append the pursuer's estimator summary (costs an estimator update per tick)
+    )
 
     def __post_init__(self) -> None:
         require(
             isinstance(self.crop_cells, int) and self.crop_cells >= 1,
-            "crop_cells", "a whole number of cells >= 1", self.crop_cells,
+            "crop_cells",
+            "a whole number of cells >= 1",
+            self.crop_cells,
         )
         require(
             self.crop_resolution > 0 and math.isfinite(self.crop_resolution),
-            "crop_resolution", "a positive length in m", self.crop_resolution,
+            "crop_resolution",
+            "a positive length in m",
+            self.crop_resolution,
         )
 
 
@@ -77,7 +83,9 @@ class _Features:
     """Layout, bounds and map normalisation of one role's observation vector, whose
     ``parts`` come before the crop."""
 
-    def __init__(self, context: Context, settings: ObservationSettings, parts: Sequence[Part]) -> None:
+    def __init__(
+        self, context: Context, settings: ObservationSettings, parts: Sequence[Part]
+    ) -> None:
         self.context = context
         self.settings = settings
         x0, x1, y0, y1 = context.grid.extent
@@ -106,7 +114,7 @@ class _Features:
         out[at + 3] = math.sin(pose.theta)
 
     def _crop(self, out: np.ndarray, pose: Pose) -> None:
-        self._local_crop(pose.x, pose.y, pose.theta, out[self._crop_at:])
+        self._local_crop(pose.x, pose.y, pose.theta, out[self._crop_at :])
 
 
 class PursuerFeatures(_Features):
@@ -169,7 +177,11 @@ class PursuerFeatures(_Features):
         out[0] = 1.0
         out[1] = min(1.0, max(-1.0, (c * dx + s * dy) / d))
         out[2] = min(1.0, max(-1.0, (-s * dx + c * dy) / d))
-        spread = 0.0 if belief.covariance is None else math.sqrt(max(0.0, float(np.trace(belief.covariance))))
+        spread = (
+            0.0
+            if belief.covariance is None
+            else math.sqrt(max(0.0, float(np.trace(belief.covariance))))
+        )
         out[3] = min(1.0, spread / d)
 
 
@@ -177,8 +189,11 @@ class EvaderFeatures(_Features):
     """The evader's observation vector (stateless)."""
 
     def __init__(self, context: Context, settings: ObservationSettings) -> None:
-        super().__init__(context, settings, [("pose", 4, -1.0, 1.0), ("pursuer", 4, -1.0, 1.0),
-                                             ("relative", 4, -1.0, 1.0)])
+        super().__init__(
+            context,
+            settings,
+            [("pose", 4, -1.0, 1.0), ("pursuer", 4, -1.0, 1.0), ("relative", 4, -1.0, 1.0)],
+        )
 
     def reset(self) -> None:
         """Nothing to forget; the same calls as :class:`PursuerFeatures` work."""

@@ -18,8 +18,8 @@ from omegaconf import DictConfig
 from pettingzoo import ParallelEnv
 
 from pegame.envs.core import EnvGame, check_seed, game_seed
-from pegame.loop import ROLES
 from pegame.envs.settings import env_config, env_settings
+from pegame.loop import ROLES
 
 
 class PursuitEvasionParallelEnv(ParallelEnv):
@@ -35,7 +35,9 @@ class PursuitEvasionParallelEnv(ParallelEnv):
 
     metadata = {"name": "pegame_pursuit_evasion_v0", "render_modes": []}
 
-    def __init__(self, config: DictConfig | None = None, overrides: Sequence[str] = (), **settings) -> None:
+    def __init__(
+        self, config: DictConfig | None = None, overrides: Sequence[str] = (), **settings
+    ) -> None:
         self.settings = env_settings(**settings)
         self.game = EnvGame(env_config(config, overrides), self.settings, ROLES)
         self.possible_agents = list(ROLES)
@@ -43,7 +45,8 @@ class PursuitEvasionParallelEnv(ParallelEnv):
         features = self.game.features
         self.layouts = {role: features[role].layout for role in ROLES}
         self.observation_spaces = {
-            role: spaces.Box(features[role].low, features[role].high, dtype=np.float32) for role in ROLES
+            role: spaces.Box(features[role].low, features[role].high, dtype=np.float32)
+            for role in ROLES
         }
         self.action_spaces = {role: spaces.Box(-1.0, 1.0, (2,), np.float32) for role in ROLES}
         self._np_random: np.random.Generator | None = None
@@ -76,6 +79,8 @@ class PursuitEvasionParallelEnv(ParallelEnv):
         self.game.close()
 
 
-def parallel_env(config: DictConfig | None = None, overrides: Sequence[str] = (), **settings) -> PursuitEvasionParallelEnv:
+def parallel_env(
+    config: DictConfig | None = None, overrides: Sequence[str] = (), **settings
+) -> PursuitEvasionParallelEnv:
     """The PettingZoo Parallel environment (see :class:`PursuitEvasionParallelEnv`)."""
     return PursuitEvasionParallelEnv(config, overrides, **settings)

@@ -11,7 +11,6 @@ from dataclasses import dataclass, fields
 from omegaconf import DictConfig, OmegaConf
 
 from pegame.config import compose
-
 from pegame.envs.observations import ObservationSettings
 from pegame.errors import ConfigError, require
 
@@ -20,7 +19,9 @@ from pegame.errors import ConfigError, require
 class EnvSettings(ObservationSettings):
     """Observation options (crop_cells, crop_resolution, belief) plus:"""
 
-    decision_period: float | None = None  # s between actions, a whole number of control ticks; None: one tick
+    decision_period: float | None = (
+        None  # s between actions, a whole number of control ticks; None: one tick
+    )
     clip_actions: bool = False  # clip out-of-range actions to [-1, 1] instead of raising ValueError
 
     def __post_init__(self) -> None:
@@ -28,7 +29,9 @@ class EnvSettings(ObservationSettings):
         period = self.decision_period
         require(
             period is None or (period > 0 and math.isfinite(period)),
-            "decision_period", "a positive duration in s, or None for one control tick", period,
+            "decision_period",
+            "a positive duration in s, or None for one control tick",
+            period,
         )
 
     @property
@@ -43,8 +46,10 @@ class EnvSettings(ObservationSettings):
             return 1
         ticks = round(self.decision_period / control_dt)
         require(
-            ticks >= 1 and math.isclose(ticks * control_dt, self.decision_period, rel_tol=1e-9, abs_tol=1e-12),
-            "decision_period", f"a whole multiple of the control period {control_dt:g} s (1 / game.control_hz)",
+            ticks >= 1
+            and math.isclose(ticks * control_dt, self.decision_period, rel_tol=1e-9, abs_tol=1e-12),
+            "decision_period",
+            f"a whole multiple of the control period {control_dt:g} s (1 / game.control_hz)",
             self.decision_period,
         )
         return ticks
@@ -58,13 +63,17 @@ def env_settings(**options) -> EnvSettings:
         if key not in allowed:
             close = difflib.get_close_matches(key, allowed, n=1)
             hint = f" Did you mean '{close[0]}'?" if close else ""
-            raise ConfigError(f"Unknown env option '{key}'.{hint} Allowed: {', '.join(allowed)}, "
-                              "plus config or overrides (and opponent for the single-agent envs).")
+            raise ConfigError(
+                f"Unknown env option '{key}'.{hint} Allowed: {', '.join(allowed)}, "
+                "plus config or overrides (and opponent for the single-agent envs)."
+            )
     return EnvSettings(**options)
 
 
 def env_config(
-    config: DictConfig | None = None, overrides: Sequence[str] = (), opponents: dict[str, str] | None = None
+    config: DictConfig | None = None,
+    overrides: Sequence[str] = (),
+    opponents: dict[str, str] | None = None,
 ) -> DictConfig:
     """The run config of an environment: ``config`` (a composed DictConfig, copied) or the
     app's config composed with ``overrides``; ``opponents`` maps a role to the strategy

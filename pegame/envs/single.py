@@ -39,7 +39,10 @@ class _SingleAgentEnv(gymnasium.Env):
     metadata = {"render_modes": []}
 
     def __init__(
-        self, config: DictConfig | None = None, overrides: Sequence[str] = (), opponent: str | None = None,
+        self,
+        config: DictConfig | None = None,
+        overrides: Sequence[str] = (),
+        opponent: str | None = None,
         **settings,
     ) -> None:
         self.settings = env_settings(**settings)

@@ -33,8 +33,8 @@ from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
 from pegame.api import Estimator
-from pegame.types import EMPTY_BELIEF, Belief, Detection, Pose
 from pegame.errors import require
+from pegame.types import EMPTY_BELIEF, Belief, Detection, Pose
 from pegame.visibility import VisibilityRegion
 
 
@@ -57,7 +57,9 @@ class KalmanEstimator(Estimator):
         super().__init__(config, context, rng)
         self._kf: KalmanFilter | None = None
 
-    def reset(self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion) -> Belief:
+    def reset(
+        self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
+    ) -> Belief:
         """Forget the track; start one at ``detection`` if there is one."""
         self._kf = None
         if detection is not None:

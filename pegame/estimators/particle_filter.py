@@ -61,13 +61,18 @@ from numba import njit
 from scipy.ndimage import distance_transform_edt
 
 from pegame.api import Estimator
-from pegame.types import Belief, Detection, Pose
 from pegame.errors import MapError, require
-from pegame.visibility import VisibilityRegion
-from pegame.trig import (
-    MAX_ANGLE, exps, sin_cos, wrap_angle_kernel, wrap_angles, wrap_angles_reference,
-)
 from pegame.estimators.resampling import RESAMPLERS, ThresholdResampler, effective_sample_size
+from pegame.trig import (
+    MAX_ANGLE,
+    exps,
+    sin_cos,
+    wrap_angle_kernel,
+    wrap_angles,
+    wrap_angles_reference,
+)
+from pegame.types import Belief, Detection, Pose
+from pegame.visibility import VisibilityRegion
 
 log = logging.getLogger(__name__)
 
@@ -216,7 +221,9 @@ class ParticleFilter(Estimator):
         resampler: str = "systematic"  # systematic, stratified, residual or multinomial
         sigma: float = 0.3  # m, std of the Gaussian likelihood of a detected position
         turn_rate_std: float = 1.0  # rad/s, std of the motion model's random turn rate
-        in_region_boost: float = 2.0  # weight factor (>= 1) inside the visible region on a detection
+        in_region_boost: float = (
+            2.0  # weight factor (>= 1) inside the visible region on a detection
+        )
         miss_factor: float = 0.05  # weight factor in [0, 1] inside the visible region on a miss
         init_spread: float = 0.3  # m, std of the initial cloud around the first detection
 
@@ -255,7 +262,9 @@ class ParticleFilter(Estimator):
 
     # ------------------------------------------------------------------ interface
 
-    def reset(self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion) -> Belief:
+    def reset(
+        self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
+    ) -> Belief:
         """Draw the initial particles: around the detection if any (N(z, init_spread) on
         free cells), else uniformly over the free cells inside ``visible`` (or over all
         free cells when none is visible); headings uniform, weights 1/N."""
@@ -263,7 +272,8 @@ class ParticleFilter(Estimator):
             if not self.context.grid.is_free(*detection.position):
                 log.info(
                     "The first detection %s lies in a blocked cell or off the map; starting "
-                    "the particles on the free cells around it.", detection.position
+                    "the particles on the free cells around it.",
+                    detection.position,
                 )
             self.particles = self._around(detection.position)
         else:
@@ -320,8 +330,13 @@ class ParticleFilter(Estimator):
         normalised), by the kernels."""
         cfg = self.config
         moved, cells = _move_and_locate(
-            self.particles, *self._draw(), self.context.evader.v_max, cfg.turn_rate_std, dt,
-            self.context.grid.frame, self.context.grid.blocked,
+            self.particles,
+            *self._draw(),
+            self.context.evader.v_max,
+            cfg.turn_rate_std,
+            dt,
+            self.context.grid.frame,
+            self.context.grid.blocked,
         )
         in_region = visible.holds(cells)  # V only where the particles are (module docstring)
         if detection is None:
@@ -329,7 +344,12 @@ class ParticleFilter(Estimator):
         else:
             likelihood = _likelihoods(moved, *detection.position, 2.0 * cfg.sigma**2)
         weights, total, evidence, n_eff = _weigh(
-            self.weights, cells, in_region, likelihood, detection is not None, cfg.in_region_boost,
+            self.weights,
+            cells,
+            in_region,
+            likelihood,
+            detection is not None,
+            cfg.in_region_boost,
             cfg.miss_factor,
         )
         return moved, weights, total, evidence, n_eff
@@ -338,7 +358,9 @@ class ParticleFilter(Estimator):
         """Plain numpy :meth:`_weigh`."""
         cfg = self.config
         unit_speeds, normals = self._draw()
-        moved = self._predict(dt, self.context.evader.v_max * unit_speeds, cfg.turn_rate_std * normals)
+        moved = self._predict(
+            dt, self.context.evader.v_max * unit_speeds, cfg.turn_rate_std * normals
+        )
         flat, on_grid = self._cells(moved[:, 0], moved[:, 1])
         valid = on_grid & ~self._blocked[flat]
         in_region = on_grid & self._flat_mask(visible.mask)[flat]
@@ -396,7 +418,8 @@ class ParticleFilter(Estimator):
         if detection is not None:
             log.info(
                 "Particle filter lost the track (no particle near the detection %s); "
-                "redrawing the particles around it.", detection.position
+                "redrawing the particles around it.",
+                detection.position,
             )
             self.particles = self._around(detection.position)
         else:

@@ -26,9 +26,10 @@ that, bit for bit), in numba kernels that skip most of the work:
   margin, so the grown V is the transform's.
 - The candidate cells of the evader's connected component are built once per component
   and grouped in square tiles (kept on the grid across games by
-  :func:`pegame.grid.per_grid`, per planner radius and candidate stride). Tiles are scored in increasing order of a lower bound of
-  their cost (the nearest distance to the evader over the farthest distance to the
-  pursuer), and the search stops at the first tile whose bound exceeds the best cost
+  :func:`pegame.grid.per_grid`, per planner radius and candidate stride). Tiles are
+  scored in increasing order of a lower bound of their cost (the nearest distance to the
+  evader over the farthest distance to the pursuer), and the search stops at the first tile
+  whose bound exceeds the best cost
   found by more than round-off could explain (a relative slack of 1e-9). Ties are broken
   explicitly by cell index, as np.argmin's first minimum does in row-major order. With
   geodesic distances there is no such bound and every tile is scored.
@@ -174,8 +175,9 @@ def _tile_bounds(boxes, ex, ey, px, py):
 
 
 @njit(cache=True)
-def _best_candidate(tiles, bounds, starts, cells, rows, cols, xs, ys, exposed, top, left,
-                    agents, effort, dist):
+def _best_candidate(
+    tiles, bounds, starts, cells, rows, cols, xs, ys, exposed, top, left, agents, effort, dist
+):
     """Algorithm 2's argmin over the unexposed cells: (flat cell, cost), (-1, inf) if none.
 
     Cells come grouped by tile (tile t holds entries starts[t] to starts[t + 1]), with
@@ -256,10 +258,14 @@ class _Component:
         by_tile = {"cells": grouped, "rows": rows[order], "cols": cols[order], "xs": xs, "ys": ys}
         starts = np.append(np.flatnonzero(np.diff(tiles[order], prepend=-1)), cells.size)
         begin = starts[:-1]
-        boxes = np.column_stack([
-            np.minimum.reduceat(xs, begin), np.maximum.reduceat(xs, begin),
-            np.minimum.reduceat(ys, begin), np.maximum.reduceat(ys, begin),
-        ])
+        boxes = np.column_stack(
+            [
+                np.minimum.reduceat(xs, begin),
+                np.maximum.reduceat(xs, begin),
+                np.minimum.reduceat(ys, begin),
+                np.maximum.reduceat(ys, begin),
+            ]
+        )
         return cls(mask, cells, position, by_tile, starts, boxes)
 
 
@@ -273,8 +279,13 @@ class EscapeSearch:
     """
 
     def __init__(
-        self, grid: OccupancyGrid, camera: Camera, planner: Planner,
-        pursuer_planner: Planner | None, distance: str, candidate_stride: int,
+        self,
+        grid: OccupancyGrid,
+        camera: Camera,
+        planner: Planner,
+        pursuer_planner: Planner | None,
+        distance: str,
+        candidate_stride: int,
         hide_margin: float,
     ) -> None:
         self.grid, self.camera = grid, camera
@@ -307,9 +318,20 @@ class EscapeSearch:
         bounds, effort, dist = self._bounds(component, me, pursuer)
         tiled = component.by_tile
         cell, cost = _best_candidate(
-            np.argsort(bounds), bounds, component.starts, tiled["cells"], tiled["rows"],
-            tiled["cols"], tiled["xs"], tiled["ys"], exposed, top, left,
-            (me.x, me.y, pursuer.x, pursuer.y), effort, dist,
+            np.argsort(bounds),
+            bounds,
+            component.starts,
+            tiled["cells"],
+            tiled["rows"],
+            tiled["cols"],
+            tiled["xs"],
+            tiled["ys"],
+            exposed,
+            top,
+            left,
+            (me.x, me.y, pursuer.x, pursuer.y),
+            effort,
+            dist,
         )
         step = _sample_step(count, MAX_RECORDED_CANDIDATES)
         sample = component.cells[_sample_positions(skipped, count, step)]

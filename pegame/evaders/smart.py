@@ -63,10 +63,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from pegame.api import Evader, EvaderObservation
-from pegame.types import STOP, Plan, Pose, Velocity
 from pegame.errors import require
 from pegame.evaders.escape import DISTANCES, EscapeSearch
 from pegame.navigation import PathFollower, Planner
+from pegame.types import STOP, Plan, Pose, Velocity
 
 log = logging.getLogger(__name__)
 
@@ -74,7 +74,9 @@ log = logging.getLogger(__name__)
 class SmartEvader(Evader):
     """Runs to the reachable cell outside the pursuer's view minimising effort / distance."""
 
-    description = "Paper's smart evader: escapes to the out-of-view cell minimising effort/distance."
+    description = (
+        "Paper's smart evader: escapes to the out-of-view cell minimising effort/distance."
+    )
 
     @dataclass
     class Config(Evader.Config):
@@ -84,10 +86,16 @@ class SmartEvader(Evader):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(self.distance in DISTANCES, "evader.distance", ", ".join(DISTANCES), self.distance)
-            require(self.hide_margin >= 0, "evader.hide_margin", "a distance >= 0 m", self.hide_margin)
             require(
-                self.candidate_stride >= 1, "evader.candidate_stride", "an integer >= 1",
+                self.distance in DISTANCES, "evader.distance", ", ".join(DISTANCES), self.distance
+            )
+            require(
+                self.hide_margin >= 0, "evader.hide_margin", "a distance >= 0 m", self.hide_margin
+            )
+            require(
+                self.candidate_stride >= 1,
+                "evader.candidate_stride",
+                "an integer >= 1",
                 self.candidate_stride,
             )
 
@@ -100,8 +108,13 @@ class SmartEvader(Evader):
             Planner.shared(grid, context.pursuer.radius) if config.distance == "geodesic" else None
         )
         self.search = EscapeSearch(
-            grid, context.camera, self.planner, pursuer_planner, config.distance,
-            config.candidate_stride, config.hide_margin,
+            grid,
+            context.camera,
+            self.planner,
+            pursuer_planner,
+            config.distance,
+            config.candidate_stride,
+            config.hide_margin,
         )
         self.follower = PathFollower(context.evader)
         self.plan = Plan()
@@ -124,10 +137,14 @@ class SmartEvader(Evader):
         if found.count == 0:
             log.info(
                 "t=%.2f s: the pursuer's view covers all free space the evader can reach; "
-                "keeping the current plan.", observation.time,
+                "keeping the current plan.",
+                observation.time,
             )
-            self.plan = Plan(self.plan.goal, self.plan.path,
-                             {"candidates": np.zeros((0, 2)), "escape_cost": math.inf})
+            self.plan = Plan(
+                self.plan.goal,
+                self.plan.path,
+                {"candidates": np.zeros((0, 2)), "escape_cost": math.inf},
+            )
             return self.plan
         cell = divmod(found.cell, self.context.grid.width)
         goal, path = self.plan.goal, self.plan.path
@@ -137,7 +154,10 @@ class SmartEvader(Evader):
             self.follower.set_path(path)
             self._goal_cell = cell
         # take() gathers rows several times faster than fancy indexing.
-        info = {"candidates": np.take(self.search.centres, found.sample, axis=0), "escape_cost": found.cost}
+        info = {
+            "candidates": np.take(self.search.centres, found.sample, axis=0),
+            "escape_cost": found.cost,
+        }
         self.plan = Plan(goal, path, info)
         return self.plan
 

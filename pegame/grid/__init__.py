@@ -19,6 +19,15 @@ from pegame.grid.occupancy import FREE, OCCUPIED, UNKNOWN, GridFrame, OccupancyG
 from pegame.grid.ros import load_map, save_map
 
 __all__ = [
-    "FREE", "OCCUPIED", "UNKNOWN", "GridFrame", "OccupancyGrid", "cell_blocked", "load_map",
-    "per_grid", "point_cell", "read_only", "save_map",
+    "FREE",
+    "OCCUPIED",
+    "UNKNOWN",
+    "GridFrame",
+    "OccupancyGrid",
+    "cell_blocked",
+    "load_map",
+    "per_grid",
+    "point_cell",
+    "read_only",
+    "save_map",
 ]

@@ -26,6 +26,12 @@ from pegame.navigation.inflation import inflate, obstacle_distance, shared_infla
 from pegame.navigation.planner import LARGE_GRID_CELLS, LARGE_GRID_LANDMARKS, PathResult, Planner
 
 __all__ = [
-    "LARGE_GRID_CELLS", "LARGE_GRID_LANDMARKS", "PathFollower", "PathResult", "Planner",
-    "inflate", "obstacle_distance", "shared_inflation",
+    "LARGE_GRID_CELLS",
+    "LARGE_GRID_LANDMARKS",
+    "PathFollower",
+    "PathResult",
+    "Planner",
+    "inflate",
+    "obstacle_distance",
+    "shared_inflation",
 ]

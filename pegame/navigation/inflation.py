@@ -47,11 +47,15 @@ def inflate(grid: OccupancyGrid, radius: float) -> np.ndarray:
 
 def shared_inflation(grid: OccupancyGrid, radius: float) -> np.ndarray:
     """``inflate(grid, radius)``, computed once per grid and radius and shared (read-only)."""
-    return per_grid(grid, ("navigation", "inflation", float(radius)),
-                    lambda grid: read_only(inflate(grid, radius)))
+    return per_grid(
+        grid,
+        ("navigation", "inflation", float(radius)),
+        lambda grid: read_only(inflate(grid, radius)),
+    )
 
 
 def shared_obstacle_distance(grid: OccupancyGrid) -> np.ndarray:
     """:func:`obstacle_distance`, computed once per grid (read-only)."""
-    return per_grid(grid, ("navigation", "obstacle distance"),
-                    lambda grid: read_only(obstacle_distance(grid)))
+    return per_grid(
+        grid, ("navigation", "obstacle distance"), lambda grid: read_only(obstacle_distance(grid))
+    )

@@ -200,8 +200,14 @@ class Planner:
                 # grow to the bound 8 n + 1 only if a search runs out.
                 self._bucket_pool = (np.empty(2 * n + 1, np.int32), np.empty(2 * n + 1, np.int32))
             dist, complete = dijkstra(
-                self._allowed, self._padded_multipliers, weighted, self.grid.resolution,
-                self._padded_width, self._flat(cell), MOVES, *self._bucket_pool,
+                self._allowed,
+                self._padded_multipliers,
+                weighted,
+                self.grid.resolution,
+                self._padded_width,
+                self._flat(cell),
+                MOVES,
+                *self._bucket_pool,
             )
             if complete:
                 return dist.reshape(self.grid.height + 2, self._padded_width)[1:-1, 1:-1]
@@ -241,8 +247,13 @@ class Planner:
         if self._astar_scratch is None:
             n = self._allowed.size
             self._astar_scratch = (
-                np.full(n, np.inf), np.empty(n, np.int32), np.empty(n), np.empty(n),
-                np.empty(n, np.int32), np.full(n, -1, np.int32), np.empty(n, np.int32),
+                np.full(n, np.inf),
+                np.empty(n, np.int32),
+                np.empty(n),
+                np.empty(n),
+                np.empty(n, np.int32),
+                np.full(n, -1, np.int32),
+                np.empty(n, np.int32),
             )
         return self._astar_scratch
 
@@ -293,8 +304,14 @@ class Planner:
                     return _unreachable("goal is outside the map")
                 return _unreachable("goal is inside an obstacle")
         cost, cells = astar(
-            self._allowed, self._padded_multipliers, self.grid.resolution, self._padded_width,
-            self._flat(start), self._flat(goal), MOVES, self._landmark_table(),
+            self._allowed,
+            self._padded_multipliers,
+            self.grid.resolution,
+            self._padded_width,
+            self._flat(start),
+            self._flat(goal),
+            MOVES,
+            self._landmark_table(),
             *self._search_scratch(),
         )
         rows, cols = np.divmod(cells, self._padded_width)

@@ -62,15 +62,18 @@ def allowed_moves(traversable, padded_width, moves):
             if not traversable[u + offsets[k]]:
                 continue
             if moves[k, 0] != 0 and moves[k, 1] != 0:
-                if not (traversable[u + moves[k, 0] * padded_width] and traversable[u + moves[k, 1]]):
+                if not (
+                    traversable[u + moves[k, 0] * padded_width] and traversable[u + moves[k, 1]]
+                ):
                     continue
             allowed[u] |= 1 << k
     return allowed
 
 
 @njit(cache=True)
-def dijkstra(allowed, multipliers, weighted, resolution, padded_width, source, moves, entry_cell,
-              entry_next):
+def dijkstra(
+    allowed, multipliers, weighted, resolution, padded_width, source, moves, entry_cell, entry_next
+):
     """Least path cost (m) from flat cell ``source`` to every cell; inf if unreachable.
 
     Dijkstra with a bucket queue (Dinitz's variant of Dial's algorithm): bucket b holds
@@ -174,7 +177,9 @@ def _pop(keys, ties, nodes, pos, size):
         # Branch-free choice of the smaller child (a data-dependent branch mispredicts
         # about every other time); keys beyond ``size`` are read but never chosen.
         key_r, key_c = keys[right], keys[child]
-        child += (right < size) & ((key_r < key_c) | ((key_r == key_c) & (ties[right] < ties[child])))
+        child += (right < size) & (
+            (key_r < key_c) | ((key_r == key_c) & (ties[right] < ties[child]))
+        )
         if key < keys[child] or (key == keys[child] and tie <= ties[child]):
             break
         keys[slot] = keys[child]
@@ -198,8 +203,23 @@ def _octile(resolution, row, col, goal_row, goal_col):
 
 
 @njit(cache=True)
-def astar(allowed, multipliers, resolution, padded_width, start, goal, moves, landmark_costs, g,
-           parent, keys, ties, nodes, pos, touched):
+def astar(
+    allowed,
+    multipliers,
+    resolution,
+    padded_width,
+    start,
+    goal,
+    moves,
+    landmark_costs,
+    g,
+    parent,
+    keys,
+    ties,
+    nodes,
+    pos,
+    touched,
+):
     """Minimum weighted cost (m) and flat cell path from ``start`` to ``goal`` by A*.
 
     The heuristic is the octile distance, admissible and consistent because every

@@ -10,14 +10,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from pegame.api import Pursuer, PursuerObservation
-from pegame.types import Plan, Pose, Velocity
 from pegame.policies import PolicyOptions, PolicyPlayer
+from pegame.types import Plan, Pose, Velocity
 
 
 class PolicyPursuer(Pursuer):
     """A trained policy (linear .npz or a callable) on the pursuer's env observation."""
 
-    description = "A learned policy (linear .npz or module:function) on the pegame.envs observation."
+    description = (
+        "A learned policy (linear .npz or module:function) on the pegame.envs observation."
+    )
 
     @dataclass
     class Config(Pursuer.Config, PolicyOptions):

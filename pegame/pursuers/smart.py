@@ -39,10 +39,10 @@ import numpy as np
 from numba import njit
 
 from pegame.api import Pursuer, PursuerObservation
-from pegame.types import Plan, Pose, Velocity, clamp, wrap_angle
 from pegame.errors import require
 from pegame.grid import OccupancyGrid, point_cell
 from pegame.navigation import PathFollower, Planner, shared_inflation
+from pegame.types import Plan, Pose, Velocity, clamp, wrap_angle
 
 log = logging.getLogger(__name__)
 
@@ -56,7 +56,9 @@ class SmartPursuer(Pursuer):
     """Centres the detected evader at a standoff distance; when it is lost, drives to the
     estimator's estimate and scans there."""
 
-    description = "Paper's hybrid: centres the seen evader at a standoff, else goes to the estimate."
+    description = (
+        "Paper's hybrid: centres the seen evader at a standoff, else goes to the estimate."
+    )
 
     @dataclass
     class Config(Pursuer.Config):
@@ -67,10 +69,17 @@ class SmartPursuer(Pursuer):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(self.standoff > 0, "pursuer.standoff", "a positive distance in m", self.standoff)
+            require(
+                self.standoff > 0, "pursuer.standoff", "a positive distance in m", self.standoff
+            )
             require(self.k_w > 0, "pursuer.k_w", "a positive gain in rad/s", self.k_w)
             require(self.k_v > 0, "pursuer.k_v", "a positive gain in 1/s", self.k_v)
-            require(self.scan_rate > 0, "pursuer.scan_rate", "a positive turn rate in rad/s", self.scan_rate)
+            require(
+                self.scan_rate > 0,
+                "pursuer.scan_rate",
+                "a positive turn rate in rad/s",
+                self.scan_rate,
+            )
 
     def __init__(self, config, context, rng) -> None:
         super().__init__(config, context, rng)
@@ -156,13 +165,18 @@ class SmartPursuer(Pursuer):
         if not result.reachable:
             log.info(
                 "t=%.1f s: estimate (%.2f, %.2f) m is unreachable (%s); scanning in place",
-                observation.time, estimate[0], estimate[1], result.reason,
+                observation.time,
+                estimate[0],
+                estimate[1],
+                result.reason,
             )
             self._start_scan(observation)
             return Plan(info={"mode": SCAN, "reason": result.reason})
         self.mode = SEARCH
         self.follower.set_path(result.path)
-        return Plan(goal=(float(estimate[0]), float(estimate[1])), path=result.path, info={"mode": SEARCH})
+        return Plan(
+            goal=(float(estimate[0]), float(estimate[1])), path=result.path, info={"mode": SEARCH}
+        )
 
     def _start_scan(self, observation: PursuerObservation) -> None:
         """Scan in place, turning toward the estimate when it lies outside the camera's
@@ -178,7 +192,6 @@ class SmartPursuer(Pursuer):
         bearing = wrap_angle(math.atan2(dy, dx) - pose.theta)
         if abs(bearing) > 0.5 * self.context.camera.fov:
             self._scan_sign = math.copysign(1.0, bearing)
-
 
 
 @njit(cache=True)

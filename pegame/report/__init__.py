@@ -33,16 +33,53 @@ from typing import Any
 
 from pegame.errors import PegameError
 from pegame.files import write_atomic
-from pegame.report.cells import Cell, canonical, code_version, group_cells, identity, other_factors, select
+from pegame.report.cells import (
+    Cell,
+    canonical,
+    code_version,
+    group_cells,
+    identity,
+    other_factors,
+    select,
+)
 from pegame.report.figures import figure_bytes, figures
-from pegame.report.hypotheses import UNTESTED, hypotheses, hypotheses_per_facet, render_hypotheses, title
+from pegame.report.hypotheses import (
+    UNTESTED,
+    hypotheses,
+    hypotheses_per_facet,
+    render_hypotheses,
+    title,
+)
 from pegame.report.load import ReportError, Sweep, load_sweep
-from pegame.report.statistics import ALPHA, BOOT_LEVEL, BOOT_RESAMPLES, BOOT_SEED, bootstrap_ci, holm
-from pegame.report.tables import (Layout, problem_sections, render_problems, render_provenance,
-                                  render_table_csv, render_table_md, render_table_tex)
+from pegame.report.statistics import (
+    ALPHA,
+    BOOT_LEVEL,
+    BOOT_RESAMPLES,
+    BOOT_SEED,
+    bootstrap_ci,
+    holm,
+)
+from pegame.report.tables import (
+    Layout,
+    problem_sections,
+    render_problems,
+    render_provenance,
+    render_table_csv,
+    render_table_md,
+    render_table_tex,
+)
 
-__all__ = ["ALPHA", "UNTESTED", "ReportError", "bootstrap_ci", "holm", "hypotheses", "load_sweep",
-           "main", "write_report"]
+__all__ = [
+    "ALPHA",
+    "UNTESTED",
+    "ReportError",
+    "bootstrap_ci",
+    "holm",
+    "hypotheses",
+    "load_sweep",
+    "main",
+    "write_report",
+]
 
 log = logging.getLogger("pegame.report")
 
@@ -54,18 +91,24 @@ def provenance(games: list[dict[str, Any]], cells: list[Cell]) -> dict[str, Any]
     hashes: dict[str, int] = {}
     for game in games:
         full = game.get("provenance")
-        entry = versions.setdefault(canonical(full), {"version": code_version(game),
-                                                     "provenance": full, "games": 0})
+        entry = versions.setdefault(
+            canonical(full), {"version": code_version(game), "provenance": full, "games": 0}
+        )
         entry["games"] += 1
         hashes[identity(game)] = hashes.get(identity(game), 0) + 1
-    warnings = [f"cell {cell.label()} mixes {' and '.join(cell.mixed())}: "
-                f"{len(cell.code_versions())} code versions, {len(cell.config_hashes())} config hashes"
-                for cell in cells if cell.mixed()]
+    warnings = [
+        f"cell {cell.label()} mixes {' and '.join(cell.mixed())}: "
+        f"{len(cell.code_versions())} code versions, {len(cell.config_hashes())} config hashes"
+        for cell in cells
+        if cell.mixed()
+    ]
     for warning in warnings:
         log.warning("%s", warning)
-    return {"code_versions": [versions[k] for k in sorted(versions)],
-            "config_hashes": [{"config_hash": h, "games": n} for h, n in sorted(hashes.items())],
-            "warnings": warnings}
+    return {
+        "code_versions": [versions[k] for k in sorted(versions)],
+        "config_hashes": [{"config_hash": h, "games": n} for h, n in sorted(hashes.items())],
+        "warnings": warnings,
+    }
 
 
 def aggregate(sweep: Sweep, dirs: list[Path]) -> tuple[dict[str, Any], list[Cell]]:
@@ -85,22 +128,26 @@ def aggregate(sweep: Sweep, dirs: list[Path]) -> tuple[dict[str, Any], list[Cell
         "failed_games": chosen.failed,
         "missing_jobs": sweep.missing,
         "unfinished_jobs": sweep.unfinished,
-        "duplicates": {"count": sum(len(d["dropped"]) for d in chosen.duplicates),
-                       "games": chosen.duplicates},
+        "duplicates": {
+            "count": sum(len(d["dropped"]) for d in chosen.duplicates),
+            "games": chosen.duplicates,
+        },
         "skipped_lines": sweep.skipped,
         "job_summaries": sweep.summaries,
     }, cells
 
 
-def write_report(sweep_dirs: str | Path | list[str | Path],
-                 out_dir: str | Path | None = None) -> dict[str, Any]:
+def write_report(
+    sweep_dirs: str | Path | list[str | Path], out_dir: str | Path | None = None
+) -> dict[str, Any]:
     """Aggregate one or more sweep directories and write the tables, figures,
     hypotheses.md and report.json into ``out_dir`` (default: the sweep directory; required
     for several). Returns report.json's content."""
     dirs = [Path(d) for d in ([sweep_dirs] if isinstance(sweep_dirs, (str, Path)) else sweep_dirs)]
     if out_dir is None and len(dirs) != 1:
-        raise ReportError(f"A report of {len(dirs)} sweep directories needs an output "
-                          f"directory (--out).")
+        raise ReportError(
+            f"A report of {len(dirs)} sweep directories needs an output directory (--out)."
+        )
     out = Path(out_dir) if out_dir is not None else dirs[0]
     report, cells = aggregate(load_sweep(dirs), dirs)
     layout = Layout(cells, report["cells"])
@@ -121,9 +168,11 @@ def write_report(sweep_dirs: str | Path | list[str | Path],
         for name, data in files.items():
             write_atomic(out / name, data)
     except OSError as error:
-        raise ReportError(f"Cannot write the report into {out}: {error.strerror or error} "
-                          f"({getattr(error, 'filename', None) or out}). Choose a writable "
-                          f"output directory with --out, or free some space.") from error
+        raise ReportError(
+            f"Cannot write the report into {out}: {error.strerror or error} "
+            f"({getattr(error, 'filename', None) or out}). Choose a writable "
+            f"output directory with --out, or free some space."
+        ) from error
     return report
 
 
@@ -133,12 +182,22 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m pegame.report",
         description="Aggregate pegame Hydra multiruns: Table 1, Fig. 5 / Fig. 8 box plots, "
-                    "hypothesis tests and report.json. Cells are configurations: every setting "
-                    "that differs between the jobs is a factor.")
-    parser.add_argument("sweep_dirs", type=Path, nargs="+", metavar="DIR",
-                        help="Hydra multirun directories (several are compared as one study)")
-    parser.add_argument("--out", type=Path, default=None,
-                        help="output directory (default: the sweep directory; required for several)")
+        "hypothesis tests and report.json. Cells are configurations: every setting "
+        "that differs between the jobs is a factor.",
+    )
+    parser.add_argument(
+        "sweep_dirs",
+        type=Path,
+        nargs="+",
+        metavar="DIR",
+        help="Hydra multirun directories (several are compared as one study)",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="output directory (default: the sweep directory; required for several)",
+    )
     args = parser.parse_args(argv)
     for directory in args.sweep_dirs:
         if not directory.is_dir():
@@ -151,10 +210,12 @@ def main(argv: list[str] | None = None) -> int:
     except PegameError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    print(f"{report['games']} games, {len(report['failed_games'])} failed, "
-          f"{len(report['failed_cells'])} failed cells, {len(report['missing_jobs'])} missing "
-          f"jobs, {report['duplicates']['count']} duplicates, {len(report['skipped_lines'])} "
-          f"skipped lines -> {args.out or args.sweep_dirs[0]}")
+    print(
+        f"{report['games']} games, {len(report['failed_games'])} failed, "
+        f"{len(report['failed_cells'])} failed cells, {len(report['missing_jobs'])} missing "
+        f"jobs, {report['duplicates']['count']} duplicates, {len(report['skipped_lines'])} "
+        f"skipped lines -> {args.out or args.sweep_dirs[0]}"
+    )
     for warning in report["provenance"]["warnings"]:
         print(f"WARNING: {warning}")
     for h in report["hypotheses"]:

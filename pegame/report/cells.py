@@ -28,14 +28,24 @@ PAIRING_ORDER = ("R-R", "S-R", "S-S", "R-S")
 AXES = ("map", "speed_ratio", "pairing")
 # Old lines (no "config"): their top-level fields and the config keys they stand for.
 LEGACY = {
-    "map": "env.name", "speed_ratio": "game.speed_ratio", "pursuer": "pursuer.name",
-    "evader": "evader.name", "estimator": "estimator.name", "detector": "detector.name",
-    "sim": "sim.name", "t_max": "game.t_max", "control_hz": "game.control_hz",
+    "map": "env.name",
+    "speed_ratio": "game.speed_ratio",
+    "pursuer": "pursuer.name",
+    "evader": "evader.name",
+    "estimator": "estimator.name",
+    "detector": "detector.name",
+    "sim": "sim.name",
+    "t_max": "game.t_max",
+    "control_hz": "game.control_hz",
     "decision_hz": "game.decision_hz",
 }
 # Settings that belong to a paper axis: the key (or key prefix) and the axis it follows.
-FOLLOWS = (("env.", "map"), ("game.speed_ratio", "speed_ratio"), ("pursuer.", "pairing"),
-           ("evader.", "pairing"))
+FOLLOWS = (
+    ("env.", "map"),
+    ("game.speed_ratio", "speed_ratio"),
+    ("pursuer.", "pairing"),
+    ("evader.", "pairing"),
+)
 CODE = ("pegame", "commit", "dirty")  # the provenance fields that name the code version
 
 
@@ -118,7 +128,13 @@ def failure_key(record: dict[str, Any], legacy: bool) -> tuple:
     """What a failed line names: (config hash, seed), or for old failed lines (they carry no
     strategy names) (map, speed_ratio, pairing, seed)."""
     if legacy:
-        return "legacy", record["map"], float(record["speed_ratio"]), record["pairing"], record["seed"]
+        return (
+            "legacy",
+            record["map"],
+            float(record["speed_ratio"]),
+            record["pairing"],
+            record["seed"],
+        )
     return identity(record), record["seed"]
 
 
@@ -142,8 +158,15 @@ def select(records: list[dict[str, Any]]) -> Selection:
             key = failure_key(record, legacy)
             finished[key] = max(index, finished.get(key, -1))
     failed = [r for key, (i, r) in failures.items() if finished.get(key, -1) < i]
-    duplicates = [{"config_hash": key[0], "seed": key[1], "kept": where(games[key][1]),
-                   "dropped": [where(r) for r in old]} for key, old in dropped.items()]
+    duplicates = [
+        {
+            "config_hash": key[0],
+            "seed": key[1],
+            "kept": where(games[key][1]),
+            "dropped": [where(r) for r in old],
+        }
+        for key, old in dropped.items()
+    ]
     return Selection([record for _, record in games.values()], failed, duplicates)
 
 
@@ -154,8 +177,14 @@ def axis_value(record: dict[str, Any], axis: str) -> Any:
 
 def follows_axis(key: str) -> str | None:
     """The paper axis a setting belongs to, None for the others."""
-    return next((axis for prefix, axis in FOLLOWS if key == prefix or
-                 (prefix.endswith(".") and key.startswith(prefix))), None)
+    return next(
+        (
+            axis
+            for prefix, axis in FOLLOWS
+            if key == prefix or (prefix.endswith(".") and key.startswith(prefix))
+        ),
+        None,
+    )
 
 
 def hashable(value: Any) -> Any:
@@ -174,10 +203,15 @@ def other_factors(games: list[dict[str, Any]]) -> list[str]:
             values.setdefault(key, set()).add(hashable(value))
             axis = follows_axis(key)
             if axis is not None:
-                per_axis.setdefault(key, {}).setdefault(axis_value(game, axis), set()).add(hashable(value))
+                per_axis.setdefault(key, {}).setdefault(axis_value(game, axis), set()).add(
+                    hashable(value)
+                )
     differing = [key for key, seen in values.items() if len(seen) > 1]
-    return sorted(key for key in differing
-                  if follows_axis(key) is None or any(len(s) > 1 for s in per_axis[key].values()))
+    return sorted(
+        key
+        for key in differing
+        if follows_axis(key) is None or any(len(s) > 1 for s in per_axis[key].values())
+    )
 
 
 @dataclass
@@ -211,8 +245,14 @@ class Cell:
 
     def mixed(self) -> list[str]:
         """What this cell mixes ('code versions', 'config hashes'), empty when nothing."""
-        return [what for what, n in (("code versions", len(self.code_versions())),
-                                     ("config hashes", len(self.config_hashes()))) if n > 1]
+        return [
+            what
+            for what, n in (
+                ("code versions", len(self.code_versions())),
+                ("config hashes", len(self.config_hashes())),
+            )
+            if n > 1
+        ]
 
     def label(self) -> str:
         """'enclosed, v_p/v_e 1, S-R, detector.miss_probability=0.3'."""
@@ -221,9 +261,15 @@ class Cell:
 
     def summary(self) -> dict[str, Any]:
         """The cell for report.json: its place, factors, statistics and provenance."""
-        return {"map": self.map, "speed_ratio": self.speed_ratio, "pairing": self.pairing,
-                "factors": self.factors, **describe(self.rates),
-                "config_hashes": self.config_hashes(), "code_versions": self.code_versions()}
+        return {
+            "map": self.map,
+            "speed_ratio": self.speed_ratio,
+            "pairing": self.pairing,
+            "factors": self.factors,
+            **describe(self.rates),
+            "config_hashes": self.config_hashes(),
+            "code_versions": self.code_versions(),
+        }
 
 
 def group_cells(games: list[dict[str, Any]], factors: list[str]) -> list[Cell]:
@@ -233,14 +279,24 @@ def group_cells(games: list[dict[str, Any]], factors: list[str]) -> list[Cell]:
     for game in games:
         flat = settings(game)
         values = {key: flat.get(key) for key in factors}
-        key = (game["map"], float(game["speed_ratio"]), game["pairing"],
-               tuple(hashable(v) for v in values.values()))
+        key = (
+            game["map"],
+            float(game["speed_ratio"]),
+            game["pairing"],
+            tuple(hashable(v) for v in values.values()),
+        )
         cells.setdefault(key, Cell(*key[:3], values)).games.append(game)
     maps = ordered({c.map for c in cells.values()}, MAP_ORDER)
     pairings = ordered({c.pairing for c in cells.values()}, PAIRING_ORDER)
-    return sorted(cells.values(), key=lambda c: (
-        [value_key(v) for v in c.factors.values()], maps.index(c.map), c.speed_ratio,
-        pairings.index(c.pairing)))
+    return sorted(
+        cells.values(),
+        key=lambda c: (
+            [value_key(v) for v in c.factors.values()],
+            maps.index(c.map),
+            c.speed_ratio,
+            pairings.index(c.pairing),
+        ),
+    )
 
 
 def facets(cells: list[Cell]) -> list[tuple[dict[str, Any], list[Cell]]]:

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import io
 import math
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import matplotlib
 from matplotlib.axes import Axes
@@ -29,20 +30,31 @@ MAX_COLUMNS = 3  # facets per row of panels
 def draw_boxes(ax: Axes, groups: list[str], series: dict[str, list[list[float]]]) -> None:
     """Per x group, one box of rates (%) per series (pairing) side by side."""
     width = 0.8 / max(1, len(series))
-    for j, (label, data) in enumerate(series.items()):
+    for j, (_label, data) in enumerate(series.items()):
         offset = (j - (len(series) - 1) / 2) * width
         kept = [(i + offset, [100 * v for v in values]) for i, values in enumerate(data) if values]
         if kept:
-            ax.boxplot([v for _, v in kept], positions=[x for x, _ in kept], widths=0.9 * width,
-                       patch_artist=True, manage_ticks=False, boxprops={"facecolor": f"C{j}"},
-                       medianprops={"color": "black"})
+            ax.boxplot(
+                [v for _, v in kept],
+                positions=[x for x, _ in kept],
+                widths=0.9 * width,
+                patch_artist=True,
+                manage_ticks=False,
+                boxprops={"facecolor": f"C{j}"},
+                medianprops={"color": "black"},
+            )
     ax.set_xticks(range(len(groups)), groups)
     ax.set_xlim(-0.6, len(groups) - 0.4)
     ax.set_ylim(-5, 105)
 
 
-def box_figure(panels: list[tuple[str, dict[str, list[list[float]]]]], groups: list[str],
-               pairings: list[str], xlabel: str, title: str) -> Figure:
+def box_figure(
+    panels: list[tuple[str, dict[str, list[list[float]]]]],
+    groups: list[str],
+    pairings: list[str],
+    xlabel: str,
+    title: str,
+) -> Figure:
     """A figure of box-plot panels [(panel title, {pairing: rates per x group})]."""
     columns = min(MAX_COLUMNS, len(panels))
     rows = math.ceil(len(panels) / columns)
@@ -52,12 +64,15 @@ def box_figure(panels: list[tuple[str, dict[str, list[list[float]]]]], groups: l
     for index, (ax, (panel, series)) in enumerate(zip(axes, panels)):
         draw_boxes(ax, groups, series)
         ax.set(xlabel=xlabel, ylabel=RATE_LABEL if index % columns == 0 else "", title=panel)
-    for ax in axes[len(panels):]:
+    for ax in axes[len(panels) :]:
         ax.set_visible(False)
     fig.suptitle(title)
     if pairings:
-        axes[0].legend(handles=[Patch(facecolor=f"C{j}", label=p) for j, p in enumerate(pairings)],
-                       title="pursuer-evader", loc="best")
+        axes[0].legend(
+            handles=[Patch(facecolor=f"C{j}", label=p) for j, p in enumerate(pairings)],
+            title="pursuer-evader",
+            loc="best",
+        )
     return fig
 
 
@@ -70,23 +85,39 @@ def figures(cells: list[Cell]) -> dict[str, Figure]:
     split = facets(cells)
 
     def panels(groups: list[Any], keep: Callable[[Cell, Any, str], bool]) -> list[tuple[str, dict]]:
-        return [(facet_text(factors), {p: [[v for c in group if keep(c, g, p) for v in c.rates]
-                                           for g in groups] for p in pairings})
-                for factors, group in split]
+        return [
+            (
+                facet_text(factors),
+                {
+                    p: [[v for c in group if keep(c, g, p) for v in c.rates] for g in groups]
+                    for p in pairings
+                },
+            )
+            for factors, group in split
+        ]
 
     return {
         "fig5a_speed_ratio": box_figure(
             panels(ratios, lambda c, r, p: c.speed_ratio == r and c.pairing == p),
-            [f"{r:g}" for r in ratios], pairings,
-            "pursuer-to-evader speed ratio $v_p/v_e$", "Success rate by speed ratio (Fig. 5a)"),
+            [f"{r:g}" for r in ratios],
+            pairings,
+            "pursuer-to-evader speed ratio $v_p/v_e$",
+            "Success rate by speed ratio (Fig. 5a)",
+        ),
         "fig5b_environment": box_figure(
             panels(maps, lambda c, m, p: c.map == m and c.pairing == p),
-            [MAP_TITLES.get(m, m) for m in maps], pairings,
-            "environment", "Success rate by environment (Fig. 5b)"),
+            [MAP_TITLES.get(m, m) for m in maps],
+            pairings,
+            "environment",
+            "Success rate by environment (Fig. 5b)",
+        ),
         "fig8_pairing": box_figure(
             panels([None], lambda c, _, p: c.pairing == p),
-            ["all environments and speed ratios"], pairings,
-            "pursuer and evader behaviour", "Overall success rate by pairing (Fig. 8)"),
+            ["all environments and speed ratios"],
+            pairings,
+            "pursuer and evader behaviour",
+            "Overall success rate by pairing (Fig. 8)",
+        ),
     }
 
 

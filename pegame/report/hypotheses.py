@@ -9,7 +9,8 @@ combination is its own family for the Holm correction.
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from pegame.report.cells import MAP_ORDER, Cell, facets, ordered, value_text
 from pegame.report.statistics import ALPHA, describe, holm, mann_whitney
@@ -26,17 +27,26 @@ def cell_summary(rates: Rates, cell: tuple[str, float, str]) -> dict[str, Any] |
     return describe(rates[cell]) if cell in rates else None
 
 
-def mann_whitney_cells(rates: Rates, cells: list[tuple[str, float]], x: str,
-                       y: str, alternative: str) -> list[dict[str, Any]]:
+def mann_whitney_cells(
+    rates: Rates, cells: list[tuple[str, float]], x: str, y: str, alternative: str
+) -> list[dict[str, Any]]:
     """Per (map, speed_ratio): one-sided Mann-Whitney U of pairing ``x``'s rates against
     ``y``'s, Holm-corrected across the tested cells; ``holds`` is None when untested."""
     rows = []
     for map_name, ratio in cells:
         a, b = rates.get((map_name, ratio, x), []), rates.get((map_name, ratio, y), [])
-        row = {"map": map_name, "speed_ratio": ratio, "x": x, "y": y,
-               "x_stats": cell_summary(rates, (map_name, ratio, x)),
-               "y_stats": cell_summary(rates, (map_name, ratio, y)),
-               "U": None, "p": None, "p_holm": None, "holds": None}
+        row = {
+            "map": map_name,
+            "speed_ratio": ratio,
+            "x": x,
+            "y": y,
+            "x_stats": cell_summary(rates, (map_name, ratio, x)),
+            "y_stats": cell_summary(rates, (map_name, ratio, y)),
+            "U": None,
+            "p": None,
+            "p_holm": None,
+            "holds": None,
+        }
         if a and b:
             u, p = mann_whitney(a, b, alternative)
             row.update(U=u, p=p)
@@ -52,19 +62,26 @@ def verdict(rows: list[dict[str, Any]]) -> dict[str, Any]:
     tested = [row["holds"] for row in rows if row["holds"] is not None]
     k, n = sum(tested), len(tested)
     word = "not tested" if n == 0 else "holds" if k == n else "fails" if k == 0 else "partly"
-    return {"verdict": word, "k": k, "n": n, "untested": len(rows) - n,
-            "text": UNTESTED if n == 0 else f"{word} (in {k} of {n} cells)"}
+    return {
+        "verdict": word,
+        "k": k,
+        "n": n,
+        "untested": len(rows) - n,
+        "text": UNTESTED if n == 0 else f"{word} (in {k} of {n} cells)",
+    }
 
 
 def hypothesis_1(rates: Rates, cells: list[tuple[str, float]]) -> dict[str, Any]:
     """H1: the smart pursuer tracks better than a random pursuer (S-R > R-R per cell)."""
     rows = mann_whitney_cells(rates, cells, "S-R", "R-R", "greater")
     return {
-        "id": "H1", "pairings": ["S-R", "R-R"],
+        "id": "H1",
+        "pairings": ["S-R", "R-R"],
         "claim": "The smart pursuer can track the evader better than a random pursuer.",
         "tested": "Per environment and speed ratio: S-R tracking rates are stochastically "
-                  "greater than R-R (one-sided Mann-Whitney U, alternative='greater').",
-        "rows": rows, "summary": verdict(rows),
+        "greater than R-R (one-sided Mann-Whitney U, alternative='greater').",
+        "rows": rows,
+        "summary": verdict(rows),
     }
 
 
@@ -76,15 +93,17 @@ def hypothesis_2(rates: Rates, cells: list[tuple[str, float]]) -> dict[str, Any]
     for row in rows:
         row["x_stats_at_1"] = cell_summary(rates, (row["map"], 1.0, "S-R"))
     return {
-        "id": "H2", "pairings": ["S-R", "R-R"],
+        "id": "H2",
+        "pairings": ["S-R", "R-R"],
         "claim": "The smart pursuer maintains a high tracking rate even with comparatively "
-                 "slower speed than the evader (paper: at half the evader's speed, Fig. 5a).",
+        "slower speed than the evader (paper: at half the evader's speed, Fig. 5a).",
         "tested": "At each speed ratio v_p/v_e < 1 (the paper's 0.5), per environment: S-R "
-                  "tracking rates are stochastically greater than R-R (one-sided Mann-Whitney "
-                  "U, alternative='greater'). The S-R mean there is shown beside the S-R mean "
-                  "at v_p/v_e = 1 for reference; 'high' has no threshold in the paper and is "
-                  "not tested.",
-        "rows": rows, "summary": verdict(rows),
+        "tracking rates are stochastically greater than R-R (one-sided Mann-Whitney "
+        "U, alternative='greater'). The S-R mean there is shown beside the S-R mean "
+        "at v_p/v_e = 1 for reference; 'high' has no threshold in the paper and is "
+        "not tested.",
+        "rows": rows,
+        "summary": verdict(rows),
     }
 
 
@@ -100,18 +119,20 @@ def hypothesis_3(rates: Rates, cells: list[tuple[str, float]]) -> dict[str, Any]
             row["holds"] = row["tracked_less"] and row["reasonable"]
     reasonable = [row["reasonable"] for row in rows if row["reasonable"] is not None]
     return {
-        "id": "H3", "pairings": ["S-S", "S-R"],
+        "id": "H3",
+        "pairings": ["S-S", "S-R"],
         "claim": "The smart pursuer maintains a reasonably high tracking performance even when "
-                 "the evader is aware of the intentions of the pursuer; tracking a smart evader "
-                 "succeeds less often than tracking a random one, and the smart pursuer has "
-                 "over 45% success rate in the majority of the scenarios.",
+        "the evader is aware of the intentions of the pursuer; tracking a smart evader "
+        "succeeds less often than tracking a random one, and the smart pursuer has "
+        "over 45% success rate in the majority of the scenarios.",
         "tested": "Per environment and speed ratio: S-S tracking rates are stochastically "
-                  "less than S-R (one-sided Mann-Whitney U, alternative='less'), and the S-S "
-                  f"mean exceeds {100 * REASONABLE_RATE:.0f}%; a cell holds when both do.",
-        "rows": rows, "summary": verdict(rows),
+        "less than S-R (one-sided Mann-Whitney U, alternative='less'), and the S-S "
+        f"mean exceeds {100 * REASONABLE_RATE:.0f}%; a cell holds when both do.",
+        "rows": rows,
+        "summary": verdict(rows),
         "reasonable_cells": {"k": sum(reasonable), "n": len(reasonable)},
         "note": f"S-S mean above {100 * REASONABLE_RATE:.0f}% in {sum(reasonable)} of "
-                f"{len(reasonable)} cells (paper: in the majority of the scenarios).",
+        f"{len(reasonable)} cells (paper: in the majority of the scenarios).",
     }
 
 
@@ -153,7 +174,9 @@ def result_text(row: dict[str, Any]) -> str:
     return UNTESTED if row["holds"] is None else "holds" if row["holds"] else "fails"
 
 
-def render_hypothesis(h: dict[str, Any], extra: list[tuple[str, Callable[[dict], str]]]) -> list[str]:
+def render_hypothesis(
+    h: dict[str, Any], extra: list[tuple[str, Callable[[dict], str]]]
+) -> list[str]:
     """One hypothesis: claim, test, per-cell table (with ``extra`` columns), verdict."""
     x, y = h["pairings"]
     columns = [
@@ -168,10 +191,13 @@ def render_hypothesis(h: dict[str, Any], extra: list[tuple[str, Callable[[dict],
         ("result", result_text),
     ]
     lines = [
-        f"## {title(h)}: {h['summary']['text']}", "",
-        f"Paper's claim: {h['claim']}", "",
+        f"## {title(h)}: {h['summary']['text']}",
+        "",
+        f"Paper's claim: {h['claim']}",
+        "",
         f"Tested: {h['tested']} Alpha = {ALPHA}, Holm-Bonferroni correction across the "
-        f"{h['summary']['n']} tested cells.", "",
+        f"{h['summary']['n']} tested cells.",
+        "",
         "| " + " | ".join(name for name, _ in columns) + " |",
         "|" + "---|" * len(columns),
     ]
@@ -185,8 +211,10 @@ def render_hypotheses(tests: list[dict[str, Any]]) -> str:
     extras = {
         "H1": [],
         "H2": [("S-R mean [CI] at v_p/v_e = 1", lambda r: cell_text(r["x_stats_at_1"]))],
-        "H3": [(f"S-S > {100 * REASONABLE_RATE:.0f}%", lambda r: flag[r["reasonable"]]),
-               ("S-S < S-R (Holm)", lambda r: flag[r["tracked_less"]])],
+        "H3": [
+            (f"S-S > {100 * REASONABLE_RATE:.0f}%", lambda r: flag[r["reasonable"]]),
+            ("S-S < S-R (Holm)", lambda r: flag[r["tracked_less"]]),
+        ],
     }
     lines = [
         "# The paper's hypotheses",
@@ -201,5 +229,3 @@ def render_hypotheses(tests: list[dict[str, Any]]) -> str:
     for h in tests:
         lines += render_hypothesis(h, extras[h["id"]])
     return "\n".join(lines)
-
-

@@ -16,9 +16,10 @@ import json
 import logging
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import yaml
 
@@ -27,7 +28,12 @@ from pegame.errors import PegameError
 log = logging.getLogger("pegame.report")
 
 RESULTS = "results.jsonl"
-NOT_CONFIG = (("game", "seed"), ("game", "trials"), ("resume",), ("hydra",))  # vary per job, not per configuration
+NOT_CONFIG = (
+    ("game", "seed"),
+    ("game", "trials"),
+    ("resume",),
+    ("hydra",),
+)  # vary per job, not per configuration
 
 
 class ReportError(PegameError, OSError):
@@ -74,16 +80,30 @@ DICT: Check = (is_dict, "an object")
 
 # Per kind: the keys that must be present, and the optional keys checked when present.
 REQUIRED: dict[str, dict[str, Check]] = {
-    "game": {"map": STR, "speed_ratio": NUMBER, "pursuer": STR, "evader": STR, "seed": INT,
-             "pairing": STR, "tracking_rate": RATE},
+    "game": {
+        "map": STR,
+        "speed_ratio": NUMBER,
+        "pursuer": STR,
+        "evader": STR,
+        "seed": INT,
+        "pairing": STR,
+        "tracking_rate": RATE,
+    },
     "failed": {"map": STR, "speed_ratio": NUMBER, "pairing": STR, "seed": INT, "error": STR},
     "invalid": {"error": STR},
     "summary": {},
 }
 OPTIONAL: dict[str, Check] = {
-    "config": DICT, "config_hash": STR, "overrides": STR_LIST, "provenance": DICT,
-    "estimator": STR, "detector": STR, "sim": STR,
-    "t_max": NUMBER, "control_hz": NUMBER, "decision_hz": NUMBER,
+    "config": DICT,
+    "config_hash": STR,
+    "overrides": STR_LIST,
+    "provenance": DICT,
+    "estimator": STR,
+    "detector": STR,
+    "sim": STR,
+    "t_max": NUMBER,
+    "control_hz": NUMBER,
+    "decision_hz": NUMBER,
 }
 
 
@@ -155,8 +175,11 @@ def problem(record: Any) -> str | None:
     if absent:
         return f"{kind} record without {', '.join(absent)}"
     checks = {**OPTIONAL, **REQUIRED[kind]}
-    wrong = [f"'{key}' is {record[key]!r}, allowed: {checks[key][1]}"
-             for key in checks if record.get(key) is not None and not checks[key][0](record[key])]
+    wrong = [
+        f"'{key}' is {record[key]!r}, allowed: {checks[key][1]}"
+        for key in checks
+        if record.get(key) is not None and not checks[key][0](record[key])
+    ]
     return f"{kind} record with a wrong type: {'; '.join(wrong)}" if wrong else None
 
 
@@ -180,7 +203,9 @@ def read_jsonl(path: Path, name: str) -> tuple[list[dict[str, Any]], list[dict[s
         text = path.read_text(encoding="utf-8", errors="replace")  # a cut may split a character
     except OSError as error:
         log.warning("skipping %s: cannot read it (%s)", name, error.strerror or error)
-        return [], [{"file": name, "line": None, "reason": f"unreadable ({error.strerror or error})"}]
+        return [], [
+            {"file": name, "line": None, "reason": f"unreadable ({error.strerror or error})"}
+        ]
     for number, line in enumerate(text.splitlines(), start=1):
         if not line.strip():
             continue
@@ -199,13 +224,17 @@ def load_sweep(roots: str | Path | list[str | Path]) -> Sweep:
     roots = [Path(r) for r in ([roots] if isinstance(roots, (str, Path)) else roots)]
     for root in roots:
         if not root.is_dir():
-            raise ReportError(f"No such sweep directory: {root}. Give the directory of a "
-                              f"multirun (the one holding the numbered job directories).")
+            raise ReportError(
+                f"No such sweep directory: {root}. Give the directory of a "
+                f"multirun (the one holding the numbered job directories)."
+            )
     sweep = Sweep()
     for root in roots:
         prefix = "" if len(roots) == 1 else f"{root.as_posix()}/"
         for job in find_job_dirs(root):
-            read_job(sweep, job, prefix + relative(job, root), prefix + relative(job / RESULTS, root))
+            read_job(
+                sweep, job, prefix + relative(job, root), prefix + relative(job / RESULTS, root)
+            )
     return sweep
 
 

@@ -21,16 +21,22 @@ BOOT_LEVEL = 0.95
 BOOT_SEED = 0
 
 
-def bootstrap_ci(values: list[float], resamples: int = BOOT_RESAMPLES, level: float = BOOT_LEVEL,
-                 seed: int = BOOT_SEED) -> tuple[float, float]:
+def bootstrap_ci(
+    values: list[float],
+    resamples: int = BOOT_RESAMPLES,
+    level: float = BOOT_LEVEL,
+    seed: int = BOOT_SEED,
+) -> tuple[float, float]:
     """Percentile-bootstrap confidence interval of the mean of ``values`` (non-empty)."""
     x = np.asarray(values, dtype=float)
     rng = np.random.default_rng(seed)
     chunk = max(1, 2**20 // x.size)  # bounds memory for large samples
-    means = np.concatenate([
-        x[rng.integers(0, x.size, size=(min(chunk, resamples - start), x.size))].mean(axis=1)
-        for start in range(0, resamples, chunk)
-    ])
+    means = np.concatenate(
+        [
+            x[rng.integers(0, x.size, size=(min(chunk, resamples - start), x.size))].mean(axis=1)
+            for start in range(0, resamples, chunk)
+        ]
+    )
     low, high = np.percentile(means, [50 * (1 - level), 50 * (1 + level)])
     return float(low), float(high)
 

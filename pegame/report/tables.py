@@ -29,8 +29,10 @@ def cell_text(cell: dict[str, Any] | None) -> str:
     """'61.3% [55.0, 67.2] n=40' for a described cell, '–' for none."""
     if cell is None:
         return "–"
-    return (f"{percent(cell['mean'])} [{100 * cell['ci_low']:.1f}, {100 * cell['ci_high']:.1f}] "
-            f"n={cell['n']}")
+    return (
+        f"{percent(cell['mean'])} [{100 * cell['ci_low']:.1f}, {100 * cell['ci_high']:.1f}] "
+        f"n={cell['n']}"
+    )
 
 
 class Layout:
@@ -44,7 +46,9 @@ class Layout:
         rows = {(c.facet, c.speed_ratio): c.factors for c in cells}
         self.rows = sorted(rows, key=lambda r: ([value_key(v) for v in rows[r].values()], r[1]))
         self.row_factors = rows
-        self.lookup = {(c.facet, c.speed_ratio, c.map, c.pairing): d for c, d in zip(cells, described)}
+        self.lookup = {
+            (c.facet, c.speed_ratio, c.map, c.pairing): d for c, d in zip(cells, described)
+        }
 
     def row_cells(self, row: tuple) -> list[dict[str, Any] | None]:
         """The described cells of one row, map-major, None where the sweep has none."""
@@ -57,7 +61,9 @@ class Layout:
 
 def render_table_md(layout: Layout, notes: list[str]) -> str:
     """Table 1 in Markdown, then ``notes`` (the provenance and problem sections)."""
-    header = layout.factors + ["v_p/v_e"] + [f"{m} {p}" for m in layout.maps for p in layout.pairings]
+    header = (
+        layout.factors + ["v_p/v_e"] + [f"{m} {p}" for m in layout.maps for p in layout.pairings]
+    )
     lines = [
         "# Table 1: mean tracking success rate",
         "",
@@ -66,21 +72,35 @@ def render_table_md(layout: Layout, notes: list[str]) -> str:
         f"smart pursuer, smart evader), with its {100 * BOOT_LEVEL:.0f}% percentile-bootstrap "
         f"confidence interval ({BOOT_RESAMPLES:,} resamples) and the number of games n. Layout "
         f"of the paper's Table 1"
-        + ("; the columns before v_p/v_e are the settings that differ between the sweep's "
-           "configurations." if layout.factors else "."),
+        + (
+            "; the columns before v_p/v_e are the settings that differ between the sweep's "
+            "configurations."
+            if layout.factors
+            else "."
+        ),
         "",
         "| " + " | ".join(header) + " |",
         "|" + "---|" * len(header),
     ]
     for row in layout.rows:
-        texts = layout.factor_texts(row) + [f"{row[1]:g}"] + [cell_text(c) for c in layout.row_cells(row)]
+        texts = (
+            layout.factor_texts(row)
+            + [f"{row[1]:g}"]
+            + [cell_text(c) for c in layout.row_cells(row)]
+        )
         lines.append("| " + " | ".join(texts) + " |")
     return "\n".join(lines + [""] + notes) + "\n"
 
 
 def csv_value(value: Any) -> Any:
     """A setting value for CSV: numbers and strings as they are, None empty, others JSON."""
-    return "" if value is None else value if isinstance(value, (int, float, str)) else value_text(value)
+    return (
+        ""
+        if value is None
+        else value
+        if isinstance(value, (int, float, str))
+        else value_text(value)
+    )
 
 
 def render_table_csv(cells: list[Cell], described: list[dict[str, Any]]) -> str:
@@ -91,9 +111,15 @@ def render_table_csv(cells: list[Cell], described: list[dict[str, Any]]) -> str:
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(["map", "speed_ratio", "pairing", *factors, *STATS])
     for cell, stats in zip(cells, described):
-        writer.writerow([cell.map, cell.speed_ratio, cell.pairing,
-                         *(csv_value(v) for v in cell.factors.values()),
-                         *("" if stats[s] is None else stats[s] for s in STATS)])
+        writer.writerow(
+            [
+                cell.map,
+                cell.speed_ratio,
+                cell.pairing,
+                *(csv_value(v) for v in cell.factors.values()),
+                *("" if stats[s] is None else stats[s] for s in STATS),
+            ]
+        )
     return buffer.getvalue()
 
 
@@ -106,27 +132,34 @@ def tex_cell(cell: dict[str, Any] | None) -> str:
     """A table cell in LaTeX: mean, then CI and n in small type."""
     if cell is None:
         return "--"
-    return (f"{100 * cell['mean']:.1f}\\% {{\\scriptsize [{100 * cell['ci_low']:.1f}, "
-            f"{100 * cell['ci_high']:.1f}] $n$={cell['n']}}}")
+    return (
+        f"{100 * cell['mean']:.1f}\\% {{\\scriptsize [{100 * cell['ci_low']:.1f}, "
+        f"{100 * cell['ci_high']:.1f}] $n$={cell['n']}}}"
+    )
 
 
 def render_table_tex(layout: Layout) -> str:
     """Table 1 as a booktabs tabular in the paper's layout (other factors leftmost)."""
     maps, width, lead = layout.maps, len(layout.pairings), len(layout.factors) + 1
     groups = " & ".join(
-        f"\\multicolumn{{{width}}}{{c}}{{\\textbf{{{tex_escape(MAP_TITLES.get(m, m))}}}}}" for m in maps
+        f"\\multicolumn{{{width}}}{{c}}{{\\textbf{{{tex_escape(MAP_TITLES.get(m, m))}}}}}"
+        for m in maps
     )
-    rules = " ".join(f"\\cmidrule(lr){{{lead + 1 + i * width}-{lead + (i + 1) * width}}}"
-                     for i in range(len(maps)))
+    rules = " ".join(
+        f"\\cmidrule(lr){{{lead + 1 + i * width}-{lead + (i + 1) * width}}}"
+        for i in range(len(maps))
+    )
     names = [f"\\texttt{{{tex_escape(f)}}}" for f in layout.factors]
     lines = [
         "% Generated by pegame.report: mean tracking success rate, 95% bootstrap CI and n per cell"
         " (paper, Table 1). Needs \\usepackage{booktabs}.",
         "\\begin{tabular}{" + "l" * lead + (" " + "c" * width) * len(maps) + "}",
         "\\toprule",
-        " & ".join(["" for _ in names] + ["\\textbf{Speed ratio}"] + ([groups] if maps else [])) + " \\\\",
+        " & ".join(["" for _ in names] + ["\\textbf{Speed ratio}"] + ([groups] if maps else []))
+        + " \\\\",
         rules,
-        " & ".join(names + ["$v_p/v_e$"] + [tex_escape(p) for _ in maps for p in layout.pairings]) + " \\\\",
+        " & ".join(names + ["$v_p/v_e$"] + [tex_escape(p) for _ in maps for p in layout.pairings])
+        + " \\\\",
         "\\midrule",
     ]
     for row in layout.rows:
@@ -147,10 +180,14 @@ def version_text(version: dict[str, Any] | None) -> str:
 def render_provenance(provenance: dict[str, Any]) -> list[str]:
     """The "Provenance" section: the code versions and configurations covered, warnings."""
     lines = ["## Provenance", ""]
-    lines += [f"- {version_text(v['version'])}: {v['games']} games" for v in provenance["code_versions"]]
+    lines += [
+        f"- {version_text(v['version'])}: {v['games']} games" for v in provenance["code_versions"]
+    ]
     lines += [f"- {len(provenance['config_hashes'])} configurations (config hashes)", ""]
     warnings = provenance["warnings"]
-    lines += [f"### Warnings: {len(warnings)}", ""] + ([f"- WARNING: {w}" for w in warnings] or ["None."])
+    lines += [f"### Warnings: {len(warnings)}", ""] + (
+        [f"- WARNING: {w}" for w in warnings] or ["None."]
+    )
     return lines + [""]
 
 
@@ -164,13 +201,15 @@ def render_problems(sections: dict[str, list[str]]) -> list[str]:
 
 def problem_sections(report: dict[str, Any]) -> dict[str, list[str]]:
     """The items of :func:`render_problems` from report.json's content."""
+
     def overrides(entry: dict[str, Any]) -> str:
         given = entry.get("overrides")
         return " ".join(given) if given is not None else "unknown"
 
     return {
         "Failed cells (invalid configuration)": [
-            f"- job {c['job']}: overrides {overrides(c)}: {c['error']}" for c in report["failed_cells"]
+            f"- job {c['job']}: overrides {overrides(c)}: {c['error']}"
+            for c in report["failed_cells"]
         ],
         "Failed games": [
             f"- {f['map']}, v_p/v_e {float(f['speed_ratio']):g}, {f['pairing']}, seed {f['seed']} "
@@ -185,10 +224,13 @@ def problem_sections(report: dict[str, Any]) -> dict[str, list[str]]:
         ],
         "Duplicate games (same config hash and seed; the later line counts)": [
             f"- config {d['config_hash'][:12]}, seed {d['seed']}: kept {d['kept']}, dropped "
-            + ", ".join(d["dropped"]) for d in report["duplicates"]["games"]
+            + ", ".join(d["dropped"])
+            for d in report["duplicates"]["games"]
         ],
         "Skipped lines": [
-            f"- {s['file']}" + (f" line {s['line']}" if s["line"] is not None else "") + f": {s['reason']}"
+            f"- {s['file']}"
+            + (f" line {s['line']}" if s["line"] is not None else "")
+            + f": {s['reason']}"
             for s in report["skipped_lines"]
         ],
     }

@@ -18,9 +18,9 @@ from dataclasses import dataclass
 from numba import njit
 
 from pegame.api import Simulator
-from pegame.types import Body, Pose, SensorFrame, Velocity, wrap_angle
 from pegame.grid import cell_blocked, point_cell
 from pegame.navigation import shared_inflation
+from pegame.types import Body, Pose, SensorFrame, Velocity, wrap_angle
 
 
 def saturate(cmd: Velocity, body: Body) -> Velocity:
@@ -114,7 +114,9 @@ class GridSimulator(Simulator):
     def reset(self, pursuer: Pose, evader: Pose) -> None:
         for agent, pose in ((self._pursuer, pursuer), (self._evader, evader)):
             if agent.collides(pose.x, pose.y):
-                raise ValueError(f"start pose {pose} is inside an obstacle for radius {agent.body.radius} m")
+                raise ValueError(
+                    f"start pose {pose} is inside an obstacle for radius {agent.body.radius} m"
+                )
             agent.pose = pose
 
     def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
@@ -126,4 +128,6 @@ class GridSimulator(Simulator):
         return self._pursuer.pose, self._evader.pose
 
     def sense(self, time: float) -> SensorFrame:
-        return SensorFrame(time=time, camera_pose=self._pursuer.pose, evader_truth=self._evader.pose)
+        return SensorFrame(
+            time=time, camera_pose=self._pursuer.pose, evader_truth=self._evader.pose
+        )

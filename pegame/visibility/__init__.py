@@ -20,6 +20,13 @@ from pegame.visibility.region import MaskRegion, visibility_region, visibility_r
 from pegame.visibility.sight import SILHOUETTE, body_in_view, fov_wedge, in_view, line_of_sight
 
 __all__ = [
-    "SILHOUETTE", "MaskRegion", "VisibilityRegion", "body_in_view", "fov_wedge", "in_view",
-    "line_of_sight", "visibility_region", "visibility_region_reference",
+    "SILHOUETTE",
+    "MaskRegion",
+    "VisibilityRegion",
+    "body_in_view",
+    "fov_wedge",
+    "in_view",
+    "line_of_sight",
+    "visibility_region",
+    "visibility_region_reference",
 ]

@@ -26,6 +26,7 @@ from pegame.types import Camera, Pose
 from pegame.visibility.rays import directions, ray_tables
 from pegame.visibility.region import MaskRegion, lookup, march, whole_region
 
+
 class VisibilityRegion:
     """The visibility region V^p_k of the camera at one pose, computed on demand (a
     :class:`pegame.types.Region`).
@@ -87,20 +88,60 @@ class VisibilityRegion:
         grid, pose, camera = self.grid, self.pose, self.camera
         angles, distances, first = ray_tables(camera)
         return (
-            grid.blocked, grid.frame, float(grid.origin[2]), float(pose.x), float(pose.y),
-            float(pose.theta), angles, distances, first, camera.angle_step, camera.distance_step,
-            camera.fov, camera.far,
+            grid.blocked,
+            grid.frame,
+            float(grid.origin[2]),
+            float(pose.x),
+            float(pose.y),
+            float(pose.theta),
+            angles,
+            distances,
+            first,
+            camera.angle_step,
+            camera.distance_step,
+            camera.fov,
+            camera.far,
         )
 
 
 @njit(cache=True)
-def _mask_over(blocked, frame, yaw, px, py, theta, angles, distances, first, angle_step,
-               distance_step, fov, far, row0, row1, col0, col1):
+def _mask_over(
+    blocked,
+    frame,
+    yaw,
+    px,
+    py,
+    theta,
+    angles,
+    distances,
+    first,
+    angle_step,
+    distance_step,
+    fov,
+    far,
+    row0,
+    row1,
+    col0,
+    col1,
+):
     """Kernel of :meth:`VisibilityRegion.mask_over`: march the rays reaching the block."""
     ox, oy, resolution = frame.ox, frame.oy, frame.resolution
     i0, i1, samples = _rays_reaching(
-        angles, angle_step, distance_step, distances.size, px, py, theta, ox, oy, yaw,
-        resolution, row0, row1, col0, col1,
+        angles,
+        angle_step,
+        distance_step,
+        distances.size,
+        px,
+        py,
+        theta,
+        ox,
+        oy,
+        yaw,
+        resolution,
+        row0,
+        row1,
+        col0,
+        col1,
     )
     mask = np.zeros(blocked.shape, dtype=np.bool_)
     if i1 > i0 and samples > first:
@@ -110,8 +151,22 @@ def _mask_over(blocked, frame, yaw, px, py, theta, angles, distances, first, ang
 
 
 @njit(cache=True)
-def _holds(cells, blocked, frame, yaw, px, py, theta, angles, distances, first, angle_step,
-           distance_step, fov, far):
+def _holds(
+    cells,
+    blocked,
+    frame,
+    yaw,
+    px,
+    py,
+    theta,
+    angles,
+    distances,
+    first,
+    angle_step,
+    distance_step,
+    fov,
+    far,
+):
     """Kernel of :meth:`VisibilityRegion.holds` for a region not yet computed whole."""
     ox, oy, resolution = frame.ox, frame.oy, frame.resolution
     near, (r0, r1, c0, c1) = _near_wedge(
@@ -119,8 +174,25 @@ def _holds(cells, blocked, frame, yaw, px, py, theta, angles, distances, first, 
     )
     if r1 < r0:
         return near  # all False
-    mask = _mask_over(blocked, frame, yaw, px, py, theta, angles, distances, first,
-                      angle_step, distance_step, fov, far, r0, r1, c0, c1)
+    mask = _mask_over(
+        blocked,
+        frame,
+        yaw,
+        px,
+        py,
+        theta,
+        angles,
+        distances,
+        first,
+        angle_step,
+        distance_step,
+        fov,
+        far,
+        r0,
+        r1,
+        c0,
+        c1,
+    )
     return lookup(mask.ravel(), cells, near)
 
 
@@ -176,8 +248,23 @@ _REACH_MARGIN = 0.5
 
 
 @njit(cache=True)
-def _rays_reaching(angles, angle_step, distance_step, n_distances, px, py, theta, ox, oy, yaw,
-                   resolution, row0, row1, col0, col1):
+def _rays_reaching(
+    angles,
+    angle_step,
+    distance_step,
+    n_distances,
+    px,
+    py,
+    theta,
+    ox,
+    oy,
+    yaw,
+    resolution,
+    row0,
+    row1,
+    col0,
+    col1,
+):
     """(first ray, stop ray, samples): the camera's rays angles[first:stop] (rad from the
     heading theta) and the number of samples along each (from the first) that can land in
     the block of cells row0..row1 x col0..col1 (inclusive), seen from (px, py) (map frame,

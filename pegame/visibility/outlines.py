@@ -54,8 +54,14 @@ def outline_rays(camera: Camera, rays: int) -> OutlineRays:
     NEAR_ARC_POINTS points along its near arc."""
     angles = camera.fov * ((np.arange(rays) + 0.5) / rays - 0.5)
     arc = np.linspace(0.5 * camera.fov, -0.5 * camera.fov, NEAR_ARC_POINTS)
-    return OutlineRays(np.cos(angles), np.sin(angles), np.cos(arc), np.sin(arc),
-                       float(camera.near), float(camera.far))
+    return OutlineRays(
+        np.cos(angles),
+        np.sin(angles),
+        np.cos(arc),
+        np.sin(arc),
+        float(camera.near),
+        float(camera.far),
+    )
 
 
 def outlines_reference(runs, frame, rays, xs, ys, thetas, z, jump=False):
@@ -128,15 +134,18 @@ def outlines_reference(runs, frame, rays, xs, ys, thetas, z, jump=False):
 _outlines_kernel = njit(cache=True)(outlines_reference)
 
 
-def visibility_outlines(grid, xs, ys, thetas, camera: Camera, rays: int, z: float = 0.0,
-                        compiled: bool = True) -> np.ndarray:
+def visibility_outlines(
+    grid, xs, ys, thetas, camera: Camera, rays: int, z: float = 0.0, compiled: bool = True
+) -> np.ndarray:
     """(P, rays + NEAR_ARC_POINTS + 1, 3) float32: closed polygons (map frame, m, at height
     z) around the visibility regions of ``camera`` at P poses (xs, ys, thetas) (m, m, rad)
     on ``grid``; see the module docstring. compiled=False runs :func:`outlines_reference`,
     which samples every cell, instead of the numba kernel, which jumps over free cells."""
     march = _outlines_kernel if compiled else outlines_reference
     xs, ys, thetas = (np.asarray(v, dtype=float).reshape(-1) for v in (xs, ys, thetas))
-    return march(free_runs(grid), grid.frame, outline_rays(camera, rays), xs, ys, thetas, float(z), compiled)
+    return march(
+        free_runs(grid), grid.frame, outline_rays(camera, rays), xs, ys, thetas, float(z), compiled
+    )
 
 
 def free_runs(grid) -> np.ndarray:

@@ -33,6 +33,7 @@ from pegame.grid import OccupancyGrid
 from pegame.types import Camera, Pose
 from pegame.visibility.rays import ray_directions, ray_tables
 
+
 def visibility_region_reference(grid: OccupancyGrid, pose: Pose, camera: Camera) -> np.ndarray:
     """Bool (H, W) mask of the cells the camera at ``pose`` (map frame) sees.
 
@@ -53,7 +54,6 @@ def visibility_region_reference(grid: OccupancyGrid, pose: Pose, camera: Camera)
     mask = np.zeros(grid.blocked.shape, dtype=bool)
     mask[rows[seen], cols[seen]] = True
     return mask
-
 
 
 #: cells; a sample whose cell coordinate is closer than this to a cell edge is recomputed

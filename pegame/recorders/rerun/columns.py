@@ -24,9 +24,26 @@ STEP, SIM_TIME = "step", "sim_time"
 
 #: the numbers buffered per tick, in this order (NaN where there is nothing)
 ROW = (
-    "step", "time", "px", "py", "ptheta", "ex", "ey", "etheta",
-    "det_x", "det_y", "box_cx", "box_cy", "box_hw", "box_hh", "confidence", "depth",
-    "mean_x", "mean_y", "n_eff", "rate",
+    "step",
+    "time",
+    "px",
+    "py",
+    "ptheta",
+    "ex",
+    "ey",
+    "etheta",
+    "det_x",
+    "det_y",
+    "box_cx",
+    "box_cy",
+    "box_hw",
+    "box_hh",
+    "confidence",
+    "depth",
+    "mean_x",
+    "mean_y",
+    "n_eff",
+    "rate",
 )
 _NO_DETECTION = (math.nan,) * 8
 
@@ -38,8 +55,16 @@ def tick_row(tick: Tick, rate: float) -> tuple:
         seen = _NO_DETECTION
     else:
         box = det.box
-        seen = (det.position[0], det.position[1], box.x + 0.5 * box.w, box.y + 0.5 * box.h,
-                0.5 * box.w, 0.5 * box.h, det.confidence, det.depth)
+        seen = (
+            det.position[0],
+            det.position[1],
+            box.x + 0.5 * box.w,
+            box.y + 0.5 * box.h,
+            0.5 * box.w,
+            0.5 * box.h,
+            det.confidence,
+            det.depth,
+        )
     mean = belief.mean if belief.mean is not None else (math.nan, math.nan)
     n_eff = belief.n_eff if belief.n_eff is not None else math.nan
     return (tick.step, tick.time, p.x, p.y, p.theta, e.x, e.y, e.theta, *seen, *mean, n_eff, rate)
@@ -150,7 +175,9 @@ class ParticleRows:
         self.count = 0
         self.started = False  # rows begin at the first tick with particles
 
-    def add(self, step: int, time: float, particles: np.ndarray | None, weights: np.ndarray | None) -> None:
+    def add(
+        self, step: int, time: float, particles: np.ndarray | None, weights: np.ndarray | None
+    ) -> None:
         """A row of (N, >= 2) particles and their (N,) weights; None gives an empty row,
         which clears the particles shown, once there have been some."""
         if particles is None and not self.started:

@@ -21,7 +21,9 @@ import rerun as rr
 
 def recording_id(out_dir: str | Path, game_id: str, properties: dict[str, Any]) -> str:
     """UUID5 of the absolute output directory, the game id and the config (see module doc)."""
-    key = json.dumps([str(Path(out_dir).resolve()), game_id, properties], sort_keys=True, default=str)
+    key = json.dumps(
+        [str(Path(out_dir).resolve()), game_id, properties], sort_keys=True, default=str
+    )
     return str(uuid.uuid5(uuid.NAMESPACE_URL, f"pegame:{key}"))
 
 
@@ -40,7 +42,9 @@ def send_property(rec: rr.RecordingStream, name: str, values: dict[str, Any]) ->
     go in as one-element Arrow arrays: the same column types as rerun-sdk infers, without
     its per-value inference (half the time)."""
     if values:
-        rec.send_property(name, rr.AnyValues(**{key: pa.array([value]) for key, value in values.items()}))
+        rec.send_property(
+            name, rr.AnyValues(**{key: pa.array([value]) for key, value in values.items()})
+        )
 
 
 def flat_config(tree: dict[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -50,5 +54,7 @@ def flat_config(tree: dict[str, Any], prefix: str = "") -> dict[str, Any]:
         if isinstance(value, dict):
             flat.update(flat_config(value, f"{prefix}{key}."))
         elif value is not None:
-            flat[f"{prefix}{key}"] = value if isinstance(value, (bool, int, float, str)) else str(value)
+            flat[f"{prefix}{key}"] = (
+                value if isinstance(value, (bool, int, float, str)) else str(value)
+            )
     return flat

@@ -33,10 +33,24 @@ from pegame.errors import require
 from pegame.recorders.files import COMPLETE, FAILED, PARTIAL, recording_path
 from pegame.recorders.rerun.blueprint import blueprint
 from pegame.recorders.rerun.columns import ParticleRows, row_columns, tick_row, time_index
-from pegame.recorders.rerun.properties import flat_config, recording_id, recording_name, send_property
+from pegame.recorders.rerun.properties import (
+    flat_config,
+    recording_id,
+    recording_name,
+    send_property,
+)
 from pegame.recorders.rerun.scene import (
-    Z_PARTICLES, Buffers, buffer_event, buffer_plan, log_agents, log_image, log_particles, log_plots,
-    log_sensing, log_static, log_trails,
+    Z_PARTICLES,
+    Buffers,
+    buffer_event,
+    buffer_plan,
+    log_agents,
+    log_image,
+    log_particles,
+    log_plots,
+    log_sensing,
+    log_static,
+    log_trails,
 )
 
 log = logging.getLogger(__name__)
@@ -50,7 +64,9 @@ class RerunRecorder(Recorder):
 
     @dataclass
     class Config:
-        spawn: bool = False  # open a live Rerun viewer (single runs); the .rrd is written either way
+        spawn: bool = (
+            False  # open a live Rerun viewer (single runs); the .rrd is written either way
+        )
         flush_every: int = 1000  # control ticks buffered per send (sends cost a fixed time each; a 90 s game is one)
         live_flush_every: int = 10  # the same with spawn=true, so that the live viewer keeps up
         max_particles: int = 100  # particles logged per tick, an evenly strided subsample (0: none)
@@ -61,14 +77,31 @@ class RerunRecorder(Recorder):
 
         def __post_init__(self) -> None:
             for key in ("flush_every", "live_flush_every", "trail_every"):
-                require(getattr(self, key) >= 1, f"recorder.{key}", "an integer >= 1", getattr(self, key))
+                require(
+                    getattr(self, key) >= 1,
+                    f"recorder.{key}",
+                    "an integer >= 1",
+                    getattr(self, key),
+                )
             for key in ("max_particles", "image_every"):
-                require(getattr(self, key) >= 0, f"recorder.{key}", "an integer >= 0", getattr(self, key))
-            require(self.outline_rays >= 2, "recorder.outline_rays", "an integer >= 2", self.outline_rays)
+                require(
+                    getattr(self, key) >= 0,
+                    f"recorder.{key}",
+                    "an integer >= 0",
+                    getattr(self, key),
+                )
+            require(
+                self.outline_rays >= 2,
+                "recorder.outline_rays",
+                "an integer >= 2",
+                self.outline_rays,
+            )
             quality = self.jpeg_quality
             require(1 <= quality <= 100, "recorder.jpeg_quality", "an integer in [1, 100]", quality)
 
-    description = "Rerun recording per game (<game_id>.rrd): map, agents, FOV, belief, plans, plots."
+    description = (
+        "Rerun recording per game (<game_id>.rrd): map, agents, FOV, belief, plans, plots."
+    )
 
     def __init__(self, config, context, rng) -> None:
         super().__init__(config, context, rng)
@@ -132,7 +165,9 @@ class RerunRecorder(Recorder):
         out_dir.mkdir(parents=True, exist_ok=True)
         self._game = (out_dir, game_id)
         self.path = recording_path(out_dir, game_id, PARTIAL)
-        rec = rr.RecordingStream(APPLICATION_ID, recording_id=recording_id(out_dir, game_id, properties))
+        rec = rr.RecordingStream(
+            APPLICATION_ID, recording_id=recording_id(out_dir, game_id, properties)
+        )
         self._rec = rec
         # Wall-clock time would only make recordings of one game differ from run to run.
         rr.set_log_time_enabled(False, recording=rec)
@@ -159,9 +194,15 @@ class RerunRecorder(Recorder):
     def _abort(self, error: BaseException) -> None:
         step, time = (self._last.step, self._last.time) if self._last is not None else (0, 0.0)
         described = f"{type(error).__name__}: {error}"
-        buffer_event(self._buffers, step, time, f"game failed after step {step}: {described}", "ERROR")
+        buffer_event(
+            self._buffers, step, time, f"game failed after step {step}: {described}", "ERROR"
+        )
         self._flush(final=True)
-        send_property(self._rec, "failure", {"error": type(error).__name__, "message": str(error), "step": step})
+        send_property(
+            self._rec,
+            "failure",
+            {"error": type(error).__name__, "message": str(error), "step": step},
+        )
         self._close(FAILED)
 
     def _close(self, status: str) -> None:
@@ -230,9 +271,16 @@ class RerunRecorder(Recorder):
         if detected == self._detected:
             return
         if self._detected is None:
-            text, level = ("evader detected at start", "INFO") if detected else ("evader not detected at start", "WARN")
+            text, level = (
+                ("evader detected at start", "INFO")
+                if detected
+                else ("evader not detected at start", "WARN")
+            )
         elif detected:
-            text, level = f"evader reacquired after {tick.time - self._changed_at:.1f} s lost", "INFO"
+            text, level = (
+                f"evader reacquired after {tick.time - self._changed_at:.1f} s lost",
+                "INFO",
+            )
         else:
             text, level = f"evader lost after {tick.time - self._changed_at:.1f} s tracked", "WARN"
         self._detected, self._changed_at = detected, tick.time

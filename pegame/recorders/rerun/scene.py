@@ -12,20 +12,28 @@ lift the overlays above the map so that nothing z-fights.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import rerun as rr
 import yaml
 
 from pegame.api import Context, Tick
+from pegame.grid import per_grid
 from pegame.recorders.rerun.columns import (
-    SIM_TIME, STEP, EntityBuffer, ParticleRows, points_at, stack_points, strips_array, time_index,
+    SIM_TIME,
+    STEP,
+    EntityBuffer,
+    ParticleRows,
+    points_at,
+    stack_points,
+    strips_array,
+    time_index,
 )
 from pegame.types import Camera, Plan, Pose
 from pegame.visibility import fov_wedge
-from pegame.grid import per_grid
 from pegame.visibility.outlines import visibility_outlines
 
 PURSUER = (220, 40, 40, 255)
@@ -55,8 +63,11 @@ def log_static(rec: rr.RecordingStream, context: Context, properties: dict[str, 
     border = [[(0, 0), (w, 0), (w, h), (0, h), (0, 0)]]
     rec.log("camera/frame", rr.LineStrips2D(border, colors=[(128, 128, 128)]), static=True)
     wedge = points_at(fov_template(context.camera), Z_REGION)
-    rec.log("world/pursuer/fov", rr.LineStrips3D([wedge], colors=[(*PURSUER[:3], 160)], radii=[0.015]),
-            static=True)
+    rec.log(
+        "world/pursuer/fov",
+        rr.LineStrips3D([wedge], colors=[(*PURSUER[:3], 160)], radii=[0.015]),
+        static=True,
+    )
     dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's, when there, is faster
     text = f"```yaml\n{yaml.dump(properties, Dumper=dumper, sort_keys=False)}```\n"
     rec.log("config", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
@@ -75,8 +86,9 @@ def grid_map(grid) -> rr.GridMap:
     data = np.ascontiguousarray(np.flipud(grid.data)).view(np.uint8)
     return rr.GridMap(
         data=data.tobytes(),
-        format=rr.components.ImageFormat(width=grid.width, height=grid.height, color_model="L",
-                                         channel_datatype="U8"),
+        format=rr.components.ImageFormat(
+            width=grid.width, height=grid.height, color_model="L", channel_datatype="U8"
+        ),
         cell_size=grid.resolution,
         translation=[ox, oy, 0.0],
         rotation_axis_angle=rr.RotationAxisAngle(axis=[0.0, 0.0, 1.0], radians=yaw),
@@ -102,22 +114,38 @@ def styles(pursuer_radius: float, evader_radius: float) -> dict[str, Any]:
         "world/detection": rr.Points3D.from_fields(colors=[DETECTION], radii=[0.12]),
         "world/belief/mean": rr.Points3D.from_fields(colors=[ESTIMATE], radii=[0.12]),
         "world/belief/particles": rr.Points3D.from_fields(radii=[0.04]),
-        "world/pursuer/visible": rr.LineStrips3D.from_fields(colors=[(255, 140, 0, 255)], radii=[0.025]),
+        "world/pursuer/visible": rr.LineStrips3D.from_fields(
+            colors=[(255, 140, 0, 255)], radii=[0.025]
+        ),
         "world/evader/candidates": rr.Points3D.from_fields(colors=[faded(EVADER)], radii=[0.08]),
         "camera/detection": rr.Boxes2D.from_fields(colors=[DETECTION]),
-        "plots/tracking/detected": rr.SeriesLines(colors=[DETECTION], names=["detected"],
-                                                  interpolation_mode=step_after),
+        "plots/tracking/detected": rr.SeriesLines(
+            colors=[DETECTION], names=["detected"], interpolation_mode=step_after
+        ),
         "plots/tracking/rate": rr.SeriesLines(colors=[PURSUER], names=["tracking rate"]),
-        "plots/distance/true": rr.SeriesLines(colors=[(90, 90, 90)], names=["pursuer-evader distance"]),
-        "plots/distance/estimate_error": rr.SeriesLines(colors=[ESTIMATE], names=["estimation error"]),
+        "plots/distance/true": rr.SeriesLines(
+            colors=[(90, 90, 90)], names=["pursuer-evader distance"]
+        ),
+        "plots/distance/estimate_error": rr.SeriesLines(
+            colors=[ESTIMATE], names=["estimation error"]
+        ),
         "plots/n_eff": rr.SeriesLines(colors=[(110, 0, 170)], names=["N_eff"]),
     }
-    for name, color, radius in (("pursuer", PURSUER, pursuer_radius), ("evader", EVADER, evader_radius)):
+    for name, color, radius in (
+        ("pursuer", PURSUER, pursuer_radius),
+        ("evader", EVADER, evader_radius),
+    ):
         looks[f"world/{name}/pose"] = rr.Points3D.from_fields(colors=[color], radii=[radius])
         looks[f"world/{name}/heading"] = rr.Arrows3D.from_fields(colors=[color], radii=[0.03])
-        looks[f"world/{name}/trajectory"] = rr.LineStrips3D.from_fields(colors=[color], radii=[0.03])
-        looks[f"world/{name}/path"] = rr.LineStrips3D.from_fields(colors=[faded(color)], radii=[0.02])
-        looks[f"world/{name}/goal"] = rr.Points3D.from_fields(colors=[faded(color, 220)], radii=[0.15])
+        looks[f"world/{name}/trajectory"] = rr.LineStrips3D.from_fields(
+            colors=[color], radii=[0.03]
+        )
+        looks[f"world/{name}/path"] = rr.LineStrips3D.from_fields(
+            colors=[faded(color)], radii=[0.02]
+        )
+        looks[f"world/{name}/goal"] = rr.Points3D.from_fields(
+            colors=[faded(color, 220)], radii=[0.15]
+        )
     return looks
 
 
@@ -129,8 +157,13 @@ def _send(rec: rr.RecordingStream, path: str, index: list, columns) -> None:
     rec.send_columns(path, indexes=index, columns=columns, strict=True)
 
 
-def log_agents(rec: rr.RecordingStream, c: dict[str, np.ndarray], every: list, context: Context,
-               outline_rays: int) -> None:
+def log_agents(
+    rec: rr.RecordingStream,
+    c: dict[str, np.ndarray],
+    every: list,
+    context: Context,
+    outline_rays: int,
+) -> None:
     """Both poses with their heading arrows; the pursuer's FOV wedge (placed by a
     transform) and the outline of its visibility region (``outline_rays`` rays)."""
     for name, prefix in AGENTS:
@@ -139,19 +172,32 @@ def log_agents(rec: rr.RecordingStream, c: dict[str, np.ndarray], every: list, c
         length = 2 * getattr(context, name).radius + 0.3
         heading = stack_points(length * np.cos(theta), length * np.sin(theta), 0.0)
         _send(rec, f"world/{name}/pose", every, rr.Points3D.columns(positions=here))
-        _send(rec, f"world/{name}/heading", every, rr.Arrows3D.columns(origins=here, vectors=heading))
+        _send(
+            rec, f"world/{name}/heading", every, rr.Arrows3D.columns(origins=here, vectors=heading)
+        )
     half = 0.5 * c["ptheta"]
     rotation = np.zeros((len(half), 4), dtype=np.float32)  # quaternions (x, y, z, w) about z
     rotation[:, 2], rotation[:, 3] = np.sin(half), np.cos(half)
-    wedge = rr.Transform3D.columns(translation=stack_points(c["px"], c["py"], 0.0), quaternion=rotation)
+    wedge = rr.Transform3D.columns(
+        translation=stack_points(c["px"], c["py"], 0.0), quaternion=rotation
+    )
     _send(rec, "world/pursuer/fov", every, wedge)
-    outlines = visibility_outlines(context.grid, c["px"], c["py"], c["ptheta"], context.camera,
-                                   outline_rays, Z_REGION)
-    _send(rec, "world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips_array(outlines)))
+    outlines = visibility_outlines(
+        context.grid, c["px"], c["py"], c["ptheta"], context.camera, outline_rays, Z_REGION
+    )
+    _send(
+        rec, "world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips_array(outlines))
+    )
 
 
-def log_trails(rec: rr.RecordingStream, c: dict[str, np.ndarray], indexes: dict, trail_every: int,
-               final: bool, trail_ends: dict[str, np.ndarray]) -> None:
+def log_trails(
+    rec: rr.RecordingStream,
+    c: dict[str, np.ndarray],
+    indexes: dict,
+    trail_every: int,
+    final: bool,
+    trail_ends: dict[str, np.ndarray],
+) -> None:
     """Both trajectories as segments, each from the previous trajectory point (kept per
     agent in ``trail_ends``, (1, 3)) to the agent's position, every ``trail_every`` ticks
     and at the last tick (``final``): the gap to the agent stays under its disc, and the
@@ -190,8 +236,12 @@ def log_sensing(rec: rr.RecordingStream, c: dict[str, np.ndarray], every: list) 
     _send(rec, "world/belief/mean", every, columns)
 
 
-def log_plots(rec: rr.RecordingStream, c: dict[str, np.ndarray], every: list,
-              index_of: Callable[[np.ndarray], list]) -> None:
+def log_plots(
+    rec: rr.RecordingStream,
+    c: dict[str, np.ndarray],
+    every: list,
+    index_of: Callable[[np.ndarray], list],
+) -> None:
     """The time series; estimation error and N_eff only at ticks that have them
     (``index_of(mask)`` gives the index columns of those rows)."""
     detected = np.isfinite(c["det_x"]).astype(float)
@@ -211,8 +261,12 @@ def log_particles(rec: rr.RecordingStream, particles: ParticleRows, indexes: dic
     if particles.count:
         steps, times, positions, shades, sizes = particles.take()
         colors = _particle_palette()[shades]
-        _send(rec, "world/belief/particles", time_index(indexes, steps, times),
-              rr.Points3D.columns(positions=positions, colors=colors).partition(sizes))
+        _send(
+            rec,
+            "world/belief/particles",
+            time_index(indexes, steps, times),
+            rr.Points3D.columns(positions=positions, colors=colors).partition(sizes),
+        )
 
 
 @lru_cache(maxsize=1)
@@ -229,7 +283,9 @@ def _particle_palette() -> np.ndarray:
 class Buffers(dict):
     """The :class:`EntityBuffer` of each entity path with rare rows (plans, events)."""
 
-    def add(self, path: str, kind: type, step: int, time: float, create: bool = True, **values) -> None:
+    def add(
+        self, path: str, kind: type, step: int, time: float, create: bool = True, **values
+    ) -> None:
         """Buffer one row of ``kind`` at ``path``; with create=False only for an entity
         that already exists (an empty row then clears what it showed)."""
         buffer = self.get(path)
@@ -250,11 +306,19 @@ def buffer_plan(buffers: Buffers, name: str, plan: Plan, tick: Tick) -> None:
     strips = [points_at(path, Z_PLAN)] if len(path) >= 2 else []
     buffers.add(f"world/{name}/path", rr.LineStrips3D, tick.step, tick.time, strips=strips)
     goal = [plan.goal] if plan.goal is not None else []
-    buffers.add(f"world/{name}/goal", rr.Points3D, tick.step, tick.time, positions=points_at(goal, Z_PLAN))
+    buffers.add(
+        f"world/{name}/goal", rr.Points3D, tick.step, tick.time, positions=points_at(goal, Z_PLAN)
+    )
     candidates = plan.info.get("candidates")
     candidates = points_at(np.zeros((0, 2)) if candidates is None else candidates, Z_PLAN)
-    buffers.add(f"world/{name}/candidates", rr.Points3D, tick.step, tick.time, create=len(candidates) > 0,
-                positions=candidates)
+    buffers.add(
+        f"world/{name}/candidates",
+        rr.Points3D,
+        tick.step,
+        tick.time,
+        create=len(candidates) > 0,
+        positions=candidates,
+    )
 
 
 def buffer_event(buffers: Buffers, step: int, time: float, text: str, level: str = "INFO") -> None:

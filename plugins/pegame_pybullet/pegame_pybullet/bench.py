@@ -21,16 +21,20 @@ from typing import Any
 import numpy as np
 
 from pegame import registry
-from pegame.types import Pose, Velocity
 from pegame.config import compose
 from pegame.game import Game, spawn
+from pegame.types import Pose, Velocity
 from pegame.visibility import line_of_sight
 
 ARC = Velocity(0.3, 0.5)  # m/s, rad/s: a command that keeps the agents moving
 
 
-def rtf(env: str = "enclosed", seeds: Iterable[int] = (0,), t_max: float = 90.0,
-        overrides: Sequence[str] = ()) -> dict[str, float]:
+def rtf(
+    env: str = "enclosed",
+    seeds: Iterable[int] = (0,),
+    t_max: float = 90.0,
+    overrides: Sequence[str] = (),
+) -> dict[str, float]:
     """Real-time factor of S-S games (smart pursuer and evader) in PyBullet with the
     segmentation detector and no recorder, camera at ``sim.camera_hz`` (10 Hz) and 160x120
     unless ``overrides`` say otherwise: ``rtf`` is simulated time over wall-clock time,
@@ -39,9 +43,21 @@ def rtf(env: str = "enclosed", seeds: Iterable[int] = (0,), t_max: float = 90.0,
     sim_time = wall = cpu = 0.0
     with tempfile.TemporaryDirectory() as out:
         for seed in seeds:
-            game = Game(compose(["sim=pybullet", "detector=segmentation", "pursuer=smart", "evader=smart",
-                                 "recorder=none", f"env={env}", f"game.t_max={t_max}", f"game.seed={seed}",
-                                 *overrides]))
+            game = Game(
+                compose(
+                    [
+                        "sim=pybullet",
+                        "detector=segmentation",
+                        "pursuer=smart",
+                        "evader=smart",
+                        "recorder=none",
+                        f"env={env}",
+                        f"game.t_max={t_max}",
+                        f"game.seed={seed}",
+                        *overrides,
+                    ]
+                )
+            )
             start, start_cpu = time.perf_counter(), time.process_time()
             game.play(out)
             wall += time.perf_counter() - start
@@ -66,14 +82,21 @@ def _why(grid, camera, radius: float, pursuer: Pose, evader: Pose) -> str:
     # The body's silhouette seen from the camera: its two extreme points across the ray.
     nx, ny = -dy / distance * radius, dx / distance * radius
     for side in (1.0, -1.0):
-        if line_of_sight(grid, (pursuer.x, pursuer.y), (evader.x + side * nx, evader.y + side * ny)):
+        if line_of_sight(
+            grid, (pursuer.x, pursuer.y), (evader.x + side * nx, evader.y + side * ny)
+        ):
             return "occlusion_edge"
     return "other"
 
 
-def visibility_agreement(env: str = "enclosed", seeds: Iterable[int] = range(3), t_max: float = 90.0,
-                         pursuer: str = "smart", evader: str = "smart",
-                         min_visible: float = 0.0) -> dict[str, Any]:
+def visibility_agreement(
+    env: str = "enclosed",
+    seeds: Iterable[int] = range(3),
+    t_max: float = 90.0,
+    pursuer: str = "smart",
+    evader: str = "smart",
+    min_visible: float = 0.0,
+) -> dict[str, Any]:
     """Agreement of PyBullet's ground-truth visibility with the grid's, on the same poses.
 
     Each game is played in the grid simulator (``sim=grid detector=oracle``, seeds
@@ -94,8 +117,14 @@ def visibility_agreement(env: str = "enclosed", seeds: Iterable[int] = range(3),
     causes: Counter[str] = Counter()
     with tempfile.TemporaryDirectory() as out:
         for seed in seeds:
-            base = [f"env={env}", f"pursuer={pursuer}", f"evader={evader}", "recorder=none",
-                    f"game.t_max={t_max}", f"game.seed={seed}"]
+            base = [
+                f"env={env}",
+                f"pursuer={pursuer}",
+                f"evader={evader}",
+                "recorder=none",
+                f"game.t_max={t_max}",
+                f"game.seed={seed}",
+            ]
             played = Game(compose(["sim=grid", "detector=oracle", *base])).play(out)
             game = Game(compose(["sim=pybullet", "detector=segmentation", *base]))
             sim, detector, context = game.plugins["sim"], game.plugins["detector"], game.context

@@ -76,15 +76,22 @@ def create_body(client: Client, parts: list[Part], collision_radius: float, heig
     radii, lengths, halves = [], [], []
     for part in parts:
         radii.append(part.size[0] if part.shape != pybullet.GEOM_BOX else 0.0)
-        lengths.append(part.size[1] if part.shape in (pybullet.GEOM_CAPSULE, pybullet.GEOM_CYLINDER) else 0.0)
+        lengths.append(
+            part.size[1] if part.shape in (pybullet.GEOM_CAPSULE, pybullet.GEOM_CYLINDER) else 0.0
+        )
         halves.append(list(part.size) if part.shape == pybullet.GEOM_BOX else [0.0, 0.0, 0.0])
     visual = client.createVisualShapeArray(
-        [part.shape for part in parts], radii=radii, lengths=lengths, halfExtents=halves,
+        [part.shape for part in parts],
+        radii=radii,
+        lengths=lengths,
+        halfExtents=halves,
         visualFramePositions=[list(part.position) for part in parts],
         rgbaColors=[[*part.rgb, 1.0] for part in parts],
     )
     collision = client.createCollisionShape(
-        pybullet.GEOM_CYLINDER, radius=collision_radius, height=height,
+        pybullet.GEOM_CYLINDER,
+        radius=collision_radius,
+        height=height,
         collisionFramePosition=[0.0, 0.0, 0.5 * height],
     )
     return client.createMultiBody(0, collision, visual)

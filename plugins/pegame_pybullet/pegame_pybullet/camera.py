@@ -39,8 +39,17 @@ FLOOR_RGB = (107, 107, 107)  # uint8: the floor body as TinyRenderer shades it (
 class DepthCamera:
     """Renders (rgb, depth, segmentation) for a camera pose; see the module docstring."""
 
-    def __init__(self, client: Client, width: int, height: int, fov: float, near: float, far: float,
-                 mount_height: float, tilt: float) -> None:
+    def __init__(
+        self,
+        client: Client,
+        width: int,
+        height: int,
+        fov: float,
+        near: float,
+        far: float,
+        mount_height: float,
+        tilt: float,
+    ) -> None:
         self.client = client
         self.width, self.height = width, height
         self.near, self.far = near, far
@@ -83,7 +92,9 @@ class DepthCamera:
         transform[:3, 3] = (pose.x, pose.y, self.mount_height)
         return transform
 
-    def render(self, transform: np.ndarray, floor_label: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def render(
+        self, transform: np.ndarray, floor_label: int
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """rgb (H, W, 3) uint8, depth (H, W) float32 m, segmentation (H, W) int32 body ids
         (-1 for nothing, ``floor_label`` for the floor) of the camera at ``transform`` (from
         :meth:`camera_to_map`); the floor body itself must be out of view."""
@@ -92,7 +103,11 @@ class DepthCamera:
         # pybullet built with numpy (the PyPI wheels) returns fresh (H, W, 4) uint8, (H, W)
         # float32 and (H, W) int32 arrays.
         _, _, rgba, zbuffer, seg = self.client.getCameraImage(
-            self.width, self.height, view, self._projection, shadow=0,
+            self.width,
+            self.height,
+            view,
+            self._projection,
+            shadow=0,
             renderer=pybullet.ER_TINY_RENDERER,
         )
         rgb = rgba[:, :, :3].copy()

@@ -24,15 +24,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from pegame.api import Detector
-from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame.errors import ConfigError, require
+from pegame.types import BoundingBox, Detection, SensorFrame
 
 
 def backproject(frame: SensorFrame, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """(3, N) map-frame points (m) of the pixels (rows, cols) at their depth."""
     k = frame.intrinsics
     z = frame.depth[rows, cols]
-    optical = np.stack([(cols + 0.5 - k[0, 2]) * (z / k[0, 0]), (rows + 0.5 - k[1, 2]) * (z / k[1, 1]), z])
+    optical = np.stack(
+        [(cols + 0.5 - k[0, 2]) * (z / k[0, 0]), (rows + 0.5 - k[1, 2]) * (z / k[1, 1]), z]
+    )
     return frame.camera_to_map[:3, :3] @ optical + frame.camera_to_map[:3, 3:]
 
 
@@ -49,7 +51,9 @@ def box_in_camera_frame(frame: SensorFrame, camera, left, top, right, bottom) ->
 class SegmentationDetector(Detector):
     """The evader's exact pixels from the segmentation mask."""
 
-    description = "Reference detector: the evader's pixels in the rendered segmentation (sim=pybullet)."
+    description = (
+        "Reference detector: the evader's pixels in the rendered segmentation (sim=pybullet)."
+    )
 
     @dataclass
     class Config:
@@ -57,9 +61,14 @@ class SegmentationDetector(Detector):
         surface_offset: float = 0.12  # m from the evader's visible surface to its axis
 
         def __post_init__(self) -> None:
-            require(self.min_pixels >= 1, "detector.min_pixels", "a whole number >= 1", self.min_pixels)
             require(
-                self.surface_offset >= 0, "detector.surface_offset", "a distance >= 0 m", self.surface_offset
+                self.min_pixels >= 1, "detector.min_pixels", "a whole number >= 1", self.min_pixels
+            )
+            require(
+                self.surface_offset >= 0,
+                "detector.surface_offset",
+                "a distance >= 0 m",
+                self.surface_offset,
             )
 
     def detect(self, frame: SensorFrame) -> Detection | None:
@@ -81,7 +90,9 @@ class SegmentationDetector(Detector):
             return None
         if kept < rows.size:
             rows, cols, x, y = rows[keep], cols[keep], x[keep], y[keep]
-        box = box_in_camera_frame(frame, camera, cols.min(), rows.min(), cols.max() + 1, rows.max() + 1)
+        box = box_in_camera_frame(
+            frame, camera, cols.min(), rows.min(), cols.max() + 1, rows.max() + 1
+        )
         surface = np.array([np.median(x), np.median(y)])
         ray = surface - origin
         position = surface + self.config.surface_offset * ray / max(float(np.hypot(*ray)), 1e-9)

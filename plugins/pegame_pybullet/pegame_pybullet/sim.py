@@ -42,9 +42,9 @@ import numpy as np
 import pybullet
 
 from pegame.api import Simulator
-from pegame.types import Body, Pose, SensorFrame, Velocity
 from pegame.errors import ConfigError, require
 from pegame.sims.grid import saturate, unicycle
+from pegame.types import Body, Pose, SensorFrame, Velocity
 from pegame_pybullet.bodies import EVADER_HEIGHT, PURSUER_HEIGHT, create_body, person, turtlebot
 from pegame_pybullet.camera import DepthCamera
 from pegame_pybullet.client import Client
@@ -62,8 +62,15 @@ def _orientation(theta: float) -> list[float]:
 class _Mover:
     """One agent's body moved as a kinematic unicycle and stopped by the walls."""
 
-    def __init__(self, client: Client, body: int, walls: tuple[int, ...], limits: Body,
-                 collision_radius: float, height: float) -> None:
+    def __init__(
+        self,
+        client: Client,
+        body: int,
+        walls: tuple[int, ...],
+        limits: Body,
+        collision_radius: float,
+        height: float,
+    ) -> None:
         self.client, self.body, self.walls, self.limits = client, body, frozenset(walls), limits
         self.radius, self.height = collision_radius, height
         self.pose = Pose(0.0, 0.0, 0.0)
@@ -76,7 +83,10 @@ class _Mover:
         self._place(x, y, theta)
         r = self.radius
         # The broadphase names the few wall boxes near (x, y); only those are tested exactly.
-        near = self.client.getOverlappingObjects([x - r, y - r, 0.0], [x + r, y + r, self.height]) or ()
+        near = (
+            self.client.getOverlappingObjects([x - r, y - r, 0.0], [x + r, y + r, self.height])
+            or ()
+        )
         for body, _ in near:
             if body in self.walls:
                 points = self.client.getClosestPoints(self.body, body, 0.0)
@@ -134,7 +144,9 @@ class PybulletSimulator(Simulator):
         camera_height: float = 0.4  # m, optical centre above the floor
         camera_tilt: float = 0.0  # rad, downward pitch; the paper's human-robot setting is pi/8
         wall_height: float = 2.0  # m, height of the extruded walls
-        collision_inset: float = 0.5  # grid cells by which collision cylinders are thinner than the bodies
+        collision_inset: float = (
+            0.5  # grid cells by which collision cylinders are thinner than the bodies
+        )
         gui: bool = False  # open the PyBullet GUI (needs a display) instead of the headless server
 
         def __post_init__(self) -> None:
@@ -142,10 +154,14 @@ class PybulletSimulator(Simulator):
                 value = getattr(self, key)
                 require(value >= 8, f"sim.{key}", "a whole number of pixels >= 8", value)
             require(self.camera_hz > 0, "sim.camera_hz", "a positive rate in Hz", self.camera_hz)
-            require(self.wall_height > 0, "sim.wall_height", "a positive height in m", self.wall_height)
             require(
-                0 < self.camera_height < self.wall_height, "sim.camera_height",
-                f"a height in m in (0, sim.wall_height = {self.wall_height})", self.camera_height,
+                self.wall_height > 0, "sim.wall_height", "a positive height in m", self.wall_height
+            )
+            require(
+                0 < self.camera_height < self.wall_height,
+                "sim.camera_height",
+                f"a height in m in (0, sim.wall_height = {self.wall_height})",
+                self.camera_height,
             )
             tilt, inset = self.camera_tilt, self.collision_inset
             require(abs(tilt) < 0.5 * math.pi, "sim.camera_tilt", "(-pi/2, pi/2) rad", tilt)
@@ -179,8 +195,16 @@ class PybulletSimulator(Simulator):
         evader = create_body(client, person(), radius, EVADER_HEIGHT)
         self._evader = _Mover(client, evader, walls, ctx.evader, radius, EVADER_HEIGHT)
         self.labels = {"evader": evader, "pursuer": pursuer, "floor": self.world.floor}
-        self.camera = DepthCamera(client, cfg.width, cfg.height, ctx.camera.fov, ctx.camera.near,
-                                  ctx.camera.far, cfg.camera_height, cfg.camera_tilt)
+        self.camera = DepthCamera(
+            client,
+            cfg.width,
+            cfg.height,
+            ctx.camera.fov,
+            ctx.camera.near,
+            ctx.camera.far,
+            cfg.camera_height,
+            cfg.camera_tilt,
+        )
         if cfg.gui:
             self._frame_gui()
 
@@ -188,8 +212,9 @@ class PybulletSimulator(Simulator):
         """Point the GUI's camera down at the middle of the map."""
         x0, x1, y0, y1 = self.context.grid.extent
         self._client.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0)
-        self._client.resetDebugVisualizerCamera(max(x1 - x0, y1 - y0), 0.0, -89.0,
-                                                [0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0])
+        self._client.resetDebugVisualizerCamera(
+            max(x1 - x0, y1 - y0), 0.0, -89.0, [0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0]
+        )
 
     # ------------------------------------------------------------- Simulator
 
@@ -197,8 +222,10 @@ class PybulletSimulator(Simulator):
         for role, free in zip(("pursuer", "evader"), self.place(pursuer, evader)):
             if not free:
                 pose = pursuer if role == "pursuer" else evader
-                raise ValueError(f"{role} start pose {pose} is inside a wall for radius "
-                                 f"{getattr(self.context, role).radius} m")
+                raise ValueError(
+                    f"{role} start pose {pose} is inside a wall for radius "
+                    f"{getattr(self.context, role).radius} m"
+                )
 
     def place(self, pursuer: Pose, evader: Pose) -> tuple[bool, bool]:
         """Put both agents at the given poses (connecting first if needed) and forget the
@@ -224,8 +251,14 @@ class PybulletSimulator(Simulator):
             transform = self.camera.camera_to_map(pose)
             rgb, depth, seg = self._render(transform)
             self._frame = SensorFrame(
-                time=time, camera_pose=pose, evader_truth=self._evader.pose, rgb=rgb, depth=depth,
-                segmentation=seg, intrinsics=self.camera.intrinsics, camera_to_map=transform,
+                time=time,
+                camera_pose=pose,
+                evader_truth=self._evader.pose,
+                rgb=rgb,
+                depth=depth,
+                segmentation=seg,
+                intrinsics=self.camera.intrinsics,
+                camera_to_map=transform,
                 labels=self.labels,
             )
         return self._frame
@@ -269,13 +302,22 @@ class PybulletSimulator(Simulator):
         if seen == 0:
             return 0.0
         camera = self.context.camera
-        wide = DepthCamera(self._client, scale * self.config.width, scale * self.config.height,
-                           2.0 * math.atan(scale * math.tan(0.5 * camera.fov)), camera.near, camera.far,
-                           self.config.camera_height, self.config.camera_tilt)
+        wide = DepthCamera(
+            self._client,
+            scale * self.config.width,
+            scale * self.config.height,
+            2.0 * math.atan(scale * math.tan(0.5 * camera.fov)),
+            camera.near,
+            camera.far,
+            self.config.camera_height,
+            self.config.camera_tilt,
+        )
         others = [*self.world.walls, self.world.floor, self.labels["pursuer"]]
         placed = [self._client.getBasePositionAndOrientation(body) for body in others]
         for body, (position, orientation) in zip(others, placed):
-            self._client.resetBasePositionAndOrientation(body, [*position[:2], HIDDEN_Z], orientation)
+            self._client.resetBasePositionAndOrientation(
+                body, [*position[:2], HIDDEN_Z], orientation
+            )
         try:
             _, _, alone = wide.render(frame.camera_to_map, self.world.floor)
         finally:

@@ -47,9 +47,9 @@ def merge_rectangles(mask: np.ndarray) -> list[tuple[int, int, int, int]]:
         span = todo[row, col:]
         w = span.size if span.all() else int(np.argmin(span))
         h = 1
-        while row + h < height and todo[row + h, col:col + w].all():
+        while row + h < height and todo[row + h, col : col + w].all():
             h += 1
-        todo[row:row + h, col:col + w] = False
+        todo[row : row + h, col : col + w] = False
         rects.append((row, col, h, w))
 
 
@@ -97,7 +97,9 @@ def build_world(client: Client, grid: OccupancyGrid, wall_height: float) -> Worl
         grown = [half[0] + VISUAL_OVERLAP, half[1] + VISUAL_OVERLAP, half[2]]
         visual = client.createVisualShape(pybullet.GEOM_BOX, halfExtents=grown, rgbaColor=WALL_RGBA)
         centre = to_map((col + 0.5 * w) * res, (row + 0.5 * h) * res)
-        walls.append(client.createMultiBody(0, collision, visual, [*centre, 0.5 * wall_height], turn))
+        walls.append(
+            client.createMultiBody(0, collision, visual, [*centre, 0.5 * wall_height], turn)
+        )
 
     # The floor spans the grid and its ring; it has no collision shape (agents move in 2D).
     half = [0.5 * (grid.width + 2) * res, 0.5 * (grid.height + 2) * res, 0.5 * FLOOR_THICKNESS]

@@ -20,15 +20,16 @@ def parse_hex(colour: str) -> tuple[float, float, float]:
     text = colour.strip().lstrip("#")
     if len(text) != 6:
         raise ValueError(colour)
-    return tuple(int(text[i:i + 2], 16) / 255 for i in (0, 2, 4))
+    return tuple(int(text[i : i + 2], 16) / 255 for i in (0, 2, 4))
 
 
 class ColourModel:
     """Evader pixels by hue. colours: '#rrggbb' strings; hue_tolerance in degrees;
     min_saturation and min_value in [0, 1] (HSV)."""
 
-    def __init__(self, colours: list[str], hue_tolerance: float, min_saturation: float,
-                 min_value: float) -> None:
+    def __init__(
+        self, colours: list[str], hue_tolerance: float, min_saturation: float, min_value: float
+    ) -> None:
         # OpenCV's 8-bit HSV has hue in [0, 180) (2 degrees per unit), S and V in [0, 255].
         self.hues = np.array([colorsys.rgb_to_hsv(*parse_hex(c))[0] * 180.0 for c in colours])
         self.tolerance = hue_tolerance / 2.0
@@ -58,7 +59,9 @@ class ColourModel:
 def find_blobs(mask: np.ndarray, min_component: int) -> np.ndarray:
     """Bool (H, W): the 8-connected components of ``mask`` with at least ``min_component``
     pixels (smaller specks are noise at colour edges)."""
-    count, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(
+        mask.astype(np.uint8), connectivity=8
+    )
     keep = np.zeros(count, dtype=bool)
     keep[1:] = stats[1:, cv2.CC_STAT_AREA] >= min_component
     return keep[labels]

@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pegame.api import Detector
-from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame.errors import ConfigError, require
+from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame_vision.colour import ColourModel, find_blobs, parse_hex
 from pegame_vision.opencv import cv2
 from pegame_vision.tracker import BoxTracker
@@ -46,9 +46,13 @@ class VisionDetector(Detector):
 
     @dataclass
     class Config:
-        colours: list[str] = field(default_factory=lambda: list(EVADER_COLOURS))  # '#rrggbb', the evader's
+        colours: list[str] = field(
+            default_factory=lambda: list(EVADER_COLOURS)
+        )  # '#rrggbb', the evader's
         hue_tolerance: float = 12.0  # degrees of hue around each colour
-        min_saturation: float = 0.25  # HSV saturation in [0, 1] below which a pixel has no reliable hue
+        min_saturation: float = (
+            0.25  # HSV saturation in [0, 1] below which a pixel has no reliable hue
+        )
         min_value: float = 0.08  # HSV value in [0, 1] below which a pixel is too dark to judge
         min_pixels: int = 12  # matching pixels needed for a detection
         min_component: int = 3  # px; smaller matching specks are noise
@@ -58,21 +62,45 @@ class VisionDetector(Detector):
         surface_offset: float = 0.12  # m from the evader's visible surface to its axis
 
         def __post_init__(self) -> None:
-            require(len(self.colours) > 0, "detector.colours", "a non-empty list of '#rrggbb'", self.colours)
+            require(
+                len(self.colours) > 0,
+                "detector.colours",
+                "a non-empty list of '#rrggbb'",
+                self.colours,
+            )
             for colour in self.colours:
                 try:
                     parse_hex(colour)
                 except ValueError:
                     require(False, "detector.colours", "colours written '#rrggbb'", colour)
             require(
-                0 < self.hue_tolerance <= 90, "detector.hue_tolerance", "(0, 90] degrees", self.hue_tolerance
+                0 < self.hue_tolerance <= 90,
+                "detector.hue_tolerance",
+                "(0, 90] degrees",
+                self.hue_tolerance,
             )
             for key in ("min_saturation", "min_value"):
-                require(0 <= getattr(self, key) <= 1, f"detector.{key}", "[0, 1]", getattr(self, key))
-            for key in ("min_pixels", "min_component", "redetect_every", "min_features", "max_features"):
-                require(getattr(self, key) >= 1, f"detector.{key}", "a whole number >= 1", getattr(self, key))
+                require(
+                    0 <= getattr(self, key) <= 1, f"detector.{key}", "[0, 1]", getattr(self, key)
+                )
+            for key in (
+                "min_pixels",
+                "min_component",
+                "redetect_every",
+                "min_features",
+                "max_features",
+            ):
+                require(
+                    getattr(self, key) >= 1,
+                    f"detector.{key}",
+                    "a whole number >= 1",
+                    getattr(self, key),
+                )
             require(
-                self.surface_offset >= 0, "detector.surface_offset", "a distance >= 0 m", self.surface_offset
+                self.surface_offset >= 0,
+                "detector.surface_offset",
+                "a distance >= 0 m",
+                self.surface_offset,
             )
 
     def __init__(self, config, context, rng) -> None:
@@ -136,12 +164,16 @@ class VisionDetector(Detector):
         self._since_detection = 1  # frames since (and including) this detection
         return box, rows, cols
 
-    def _place(self, frame: SensorFrame, box, rows: np.ndarray, cols: np.ndarray) -> Detection | None:
+    def _place(
+        self, frame: SensorFrame, box, rows: np.ndarray, cols: np.ndarray
+    ) -> Detection | None:
         """The detection from the box (px) and the evader's sample pixels, or None when too
         few samples have a depth within range."""
         k, transform = frame.intrinsics, frame.camera_to_map
         z = frame.depth[rows, cols].astype(float)
-        optical = np.stack([(cols + 0.5 - k[0, 2]) * z / k[0, 0], (rows + 0.5 - k[1, 2]) * z / k[1, 1], z])
+        optical = np.stack(
+            [(cols + 0.5 - k[0, 2]) * z / k[0, 0], (rows + 0.5 - k[1, 2]) * z / k[1, 1], z]
+        )
         with np.errstate(invalid="ignore"):  # inf depth (no return) gives nan, dropped below
             x, y, _ = transform[:3, :3] @ optical + transform[:3, 3:]
         origin = transform[:2, 3]

@@ -29,9 +29,9 @@ from typing import Any
 import numpy as np
 
 from pegame import registry
-from pegame.types import BoundingBox, Detection, Pose, SensorFrame
 from pegame.config import compose
 from pegame.game import Game
+from pegame.types import BoundingBox, Detection, Pose, SensorFrame
 
 
 def iou(a: BoundingBox, b: BoundingBox) -> float:
@@ -61,8 +61,10 @@ class _Judge:
         seen = self.vision.detect(frame)
         if truth is None:
             kind = "negative"
-        elif (frame.camera_pose.distance_to(frame.evader_truth) <= self.max_range
-              and self.sim.evader_visible_fraction() >= self.min_visible):
+        elif (
+            frame.camera_pose.distance_to(frame.evader_truth) <= self.max_range
+            and self.sim.evader_visible_fraction() >= self.min_visible
+        ):
             kind = "positive"
         else:
             kind = "ignored"
@@ -70,9 +72,16 @@ class _Judge:
         return truth
 
 
-def evaluate(env: str = "enclosed", seeds: Iterable[int] = range(3), t_max: float = 60.0,
-             max_range: float = 4.0, min_visible: float = 0.3, iou_threshold: float = 0.5,
-             vision: Mapping[str, Any] | None = None, overrides: Iterable[str] = ()) -> dict[str, Any]:
+def evaluate(
+    env: str = "enclosed",
+    seeds: Iterable[int] = range(3),
+    t_max: float = 60.0,
+    max_range: float = 4.0,
+    min_visible: float = 0.3,
+    iou_threshold: float = 0.5,
+    vision: Mapping[str, Any] | None = None,
+    overrides: Iterable[str] = (),
+) -> dict[str, Any]:
     """Precision, recall and mean box IoU of ``detector=vision`` (with the parameters in
     ``vision``, defaults otherwise) against ``detector=segmentation`` over S-S games on
     ``env``, one per seed, ``t_max`` s each, the game config changed by ``overrides``
@@ -82,11 +91,25 @@ def evaluate(env: str = "enclosed", seeds: Iterable[int] = range(3), t_max: floa
     rows = []
     with tempfile.TemporaryDirectory() as out:
         for seed in seeds:
-            game = Game(compose(["sim=pybullet", "detector=segmentation", "pursuer=smart", "evader=smart",
-                                 "recorder=none", f"env={env}", f"game.t_max={t_max}", f"game.seed={seed}",
-                                 *overrides]))
+            game = Game(
+                compose(
+                    [
+                        "sim=pybullet",
+                        "detector=segmentation",
+                        "pursuer=smart",
+                        "evader=smart",
+                        "recorder=none",
+                        f"env={env}",
+                        f"game.t_max={t_max}",
+                        f"game.seed={seed}",
+                        *overrides,
+                    ]
+                )
+            )
             detector = vision_cls(vision_config, game.context, np.random.default_rng(seed))
-            judge = _Judge(game.plugins["detector"], detector, game.plugins["sim"], max_range, min_visible)
+            judge = _Judge(
+                game.plugins["detector"], detector, game.plugins["sim"], max_range, min_visible
+            )
             game.plugins["detector"] = judge
             game.play(out)
             rows += judge.rows
@@ -98,8 +121,11 @@ def _score(rows, iou_threshold: float) -> dict[str, Any]:
     positives = [row for row in rows if row[0] == "positive"]
     judged = [row for row in rows if row[0] != "ignored" and row[2] is not None]
     overlaps = [iou(truth.box, seen.box) for _, truth, seen, _ in positives if seen is not None]
-    matched = [(seen, evader) for _, truth, seen, evader in positives
-               if seen is not None and iou(truth.box, seen.box) >= iou_threshold]
+    matched = [
+        (seen, evader)
+        for _, truth, seen, evader in positives
+        if seen is not None and iou(truth.box, seen.box) >= iou_threshold
+    ]
     errors = [math.hypot(seen.position[0] - e.x, seen.position[1] - e.y) for seen, e in matched]
     return {
         "vision_precision": len(matched) / len(judged) if judged else None,

@@ -14,8 +14,11 @@ import numpy as np
 
 from pegame_vision.opencv import cv2
 
-LK_PARAMS = dict(winSize=(9, 9), maxLevel=2,
-                 criteria=(cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 20, 0.03))
+LK_PARAMS = {
+    "winSize": (9, 9),
+    "maxLevel": 2,
+    "criteria": (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 20, 0.03),
+}
 
 
 class BoxTracker:
@@ -31,7 +34,9 @@ class BoxTracker:
     def start(self, gray: np.ndarray, box: np.ndarray, mask: np.ndarray) -> int:
         """Track ``box`` from ``gray`` (H, W) uint8, with features on ``mask`` (H, W) bool;
         returns the number of features found."""
-        corners = cv2.goodFeaturesToTrack(gray, self.max_features, 0.01, 2, mask=mask.astype(np.uint8))
+        corners = cv2.goodFeaturesToTrack(
+            gray, self.max_features, 0.01, 2, mask=mask.astype(np.uint8)
+        )
         self.points = np.zeros((0, 2), np.float32) if corners is None else corners.reshape(-1, 2)
         self.box = np.asarray(box, dtype=float)
         self._gray = gray
