@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 from pegame.api import Detector
 from pegame.errors import require
-from pegame.types import BoundingBox, Detection, SensorFrame
+from pegame.types import BoundingBox, Detection, SensorFrame, wrap_angle
 from pegame.visibility import in_view
 
 
@@ -62,7 +62,7 @@ class OracleDetector(Detector):
             return None
         distance = cam.distance_to(evader)
         bearing = math.atan2(evader.y - cam.y, evader.x - cam.x) - cam.theta
-        bearing = math.remainder(bearing, 2 * math.pi)
+        bearing = wrap_angle(bearing)
         half = math.asin(min(1.0, self.context.evader.radius / distance))
         left = max(0.0, camera.column_of(bearing + half))
         right = min(float(camera.image_width), camera.column_of(bearing - half))

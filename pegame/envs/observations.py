@@ -44,7 +44,7 @@ import numpy as np
 from pegame.api import Context, EvaderObservation, PursuerObservation
 from pegame.envs.crop import LocalCrop
 from pegame.errors import require
-from pegame.types import Belief, Detection, Pose
+from pegame.types import Belief, Detection, Pose, wrap_angle
 
 #: s; detection ages are divided by this and capped at 1
 AGE_SCALE = 10.0
@@ -151,7 +151,7 @@ class PursuerFeatures(_Features):
             seen_at, x, y = self._last
             dx, dy = x - pose.x, y - pose.y
             out[5] = min(1.0, math.hypot(dx, dy) / self.context.camera.far)
-            out[6] = math.remainder(math.atan2(dy, dx) - pose.theta, 2.0 * math.pi) / math.pi
+            out[6] = wrap_angle(math.atan2(dy, dx) - pose.theta) / math.pi
             out[7] = min(1.0, (time - seen_at) / AGE_SCALE)
         if self.settings.belief:
             self._belief(out[8:12], pose, belief)

@@ -23,7 +23,7 @@ import numpy as np
 from pegame import registry
 from pegame.config import compose
 from pegame.game import Game, spawn
-from pegame.types import Pose, Velocity
+from pegame.types import Pose, Velocity, wrap_angle
 from pegame.visibility import line_of_sight
 
 ARC = Velocity(0.3, 0.5)  # m/s, rad/s: a command that keeps the agents moving
@@ -62,7 +62,7 @@ def rtf(
             game.play(out)
             wall += time.perf_counter() - start
             cpu += time.process_time() - start_cpu
-            sim_time += game.settings.t_max
+            sim_time += game.scenario.settings.t_max
     return {"rtf": sim_time / wall, "rtf_cpu": sim_time / cpu}
 
 
@@ -74,7 +74,7 @@ def _why(grid, camera, radius: float, pursuer: Pose, evader: Pose) -> str:
     if distance <= radius:
         return "overlap"
     widen = math.asin(min(1.0, radius / distance))
-    bearing = abs(math.remainder(math.atan2(dy, dx) - pursuer.theta, 2 * math.pi))
+    bearing = abs(wrap_angle(math.atan2(dy, dx) - pursuer.theta))
     if bearing > 0.5 * camera.fov:
         return "fov_edge" if bearing <= 0.5 * camera.fov + widen else "other"
     if not camera.near <= distance <= camera.far:

@@ -34,3 +34,10 @@ def test_a_short_smart_game_runs_end_to_end_and_is_recorded(tmp_path):
     assert (tmp_path / "game.rrd").stat().st_size > 0
     write_outcome(outcome, tmp_path)
     assert json.loads((tmp_path / "result.json").read_text())["pairing"] == "S-S"
+
+
+def test_the_real_time_factor_benchmark_plays_its_games():
+    from pegame_pybullet.bench import rtf
+
+    figures = rtf(t_max=2.0)
+    assert figures["rtf"] > 0 and figures["rtf_cpu"] > 0
