@@ -283,3 +283,15 @@ def test_config_file_matches_the_defaults():
     own = {f.name for f in fields(defaults)} - {"radius", "w_max"}
     assert set(node) == own
     assert all(node[key] == getattr(defaults, key) for key in own)
+
+
+def test_a_blocked_approach_detours_around_the_wall_end_unless_the_detour_is_off():
+    data = np.full((60, 60), FREE, dtype=np.int8)
+    data[:30, 40:43] = OCCUPIED  # a wall at x 4.0-4.3 m up to y = 3 m
+    grid = OccupancyGrid(data, RES)
+    pose = Pose(3.6, 2.0, 0.0)  # facing the wall, 0.2 m from its inflated face
+    beyond = Detection(BoundingBox(300.0, 100.0, 40.0, 200.0), 2.0, (5.0, 3.8))
+    detour = make_pursuer(grid).control(observe(pose, beyond))
+    wait = make_pursuer(grid, detour=False).control(observe(pose, beyond))
+    assert detour.w > 0.0  # it turns left, onto the planned path round the wall end
+    assert wait.v == 0.0 and wait.w == pytest.approx(0.0)  # it stays, the evader centred

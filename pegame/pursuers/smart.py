@@ -17,7 +17,8 @@ the body's limits. When the straight motion over a short look-ahead would enter 
 pursuer's inflated obstacle cells (``inflate(grid, radius)``, the simulator's collision
 mask of the robot's centre), backing off stops (v = 0) and approaching becomes a detour:
 the pursuer follows a planned path to the detected position, as move_base would, instead
-of standing at the corner that its line of sight grazes.
+of standing at the corner that its line of sight grazes (``detour``, not in the paper:
+false makes it stop and turn there).
 
 Searching (no detection): the pursuer plans from its pose to the estimator's estimate,
 the weighted mean of the particles (``observation.belief.mean``, map frame, m), and
@@ -66,6 +67,7 @@ class SmartPursuer(Pursuer):
         k_w: float = 4.0  # rad/s per unit of image offset (box centre offset / image width)
         k_v: float = 1.0  # 1/s, forward speed per metre of depth error (depth - standoff)
         scan_rate: float = 1.0  # rad/s, turn rate when scanning in place
+        detour: bool = True  # plan around an obstacle the line of sight grazes (false: wait)
 
         def __post_init__(self) -> None:
             super().__post_init__()
@@ -129,7 +131,8 @@ class SmartPursuer(Pursuer):
         v = clamp(self.config.k_v * (detection.depth - self.config.standoff), body.v_max)
         reach = math.copysign(max(abs(v) * LOOKAHEAD_TIME, body.radius), v)
         if v != 0.0 and not self._clear(observation.pose, reach):
-            return self._detour(observation, w) if v > 0 else Velocity(0.0, w)
+            blocked_ahead = v > 0 and self.config.detour
+            return self._detour(observation, w) if blocked_ahead else Velocity(0.0, w)
         return Velocity(v, w)
 
     def _detour(self, observation: PursuerObservation, w: float) -> Velocity:
