@@ -200,6 +200,9 @@ def test_compare_names_what_the_sweep_has_when_asked_for_what_it_lacks(tmp_path)
         report.write_report(tmp_path, tmp_path / "out", [("detector.miss_probability", "0", "1")])
     with pytest.raises(report.CompareError, match="not FACTOR=A,B"):
         parse_compare("detector.miss_probability=0")
+    twice = [("detector.miss_probability", "0", "0.3"), ("detector.miss_probability", "0.3", "0")]
+    with pytest.raises(report.CompareError, match="more than once"):
+        report.write_report(tmp_path, tmp_path / "out", twice)
     assert not (tmp_path / "out").exists()
 
 

@@ -31,6 +31,7 @@ import argparse
 import json
 import logging
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -153,7 +154,7 @@ def aggregate(sweep: Sweep, dirs: list[Path]) -> tuple[dict[str, Any], list[Cell
 def write_report(
     sweep_dirs: str | Path | list[str | Path],
     out_dir: str | Path | None = None,
-    comparisons: list[tuple[str, str, str]] = (),
+    comparisons: Sequence[tuple[str, str, str]] = (),
 ) -> dict[str, Any]:
     """Aggregate one or more sweep directories and write the tables, figures,
     hypotheses.md and report.json into ``out_dir`` (default: the sweep directory; required
