@@ -16,7 +16,10 @@ percentile-bootstrap confidence interval, the median and the standard deviation
   paper's Fig. 5 and Fig. 8, PNG and SVG, one panel per combination of the other factors
   (:mod:`~pegame.report.figures`);
 - ``hypotheses.md``: the paper's three hypotheses, tested per combination of the other
-  factors (:mod:`~pegame.report.hypotheses`);
+  factors (:mod:`~pegame.report.hypotheses`), unpaired (Mann-Whitney U) and, on the seeds
+  both pairings share, paired (Wilcoxon signed-rank, :mod:`~pegame.report.paired`);
+- with ``--compare FACTOR=A,B`` (repeatable): ``compare_<FACTOR>.md`` / ``.csv``, value B
+  of one factor against value A per cell on common seeds (:mod:`~pegame.report.compare`);
 - ``report.json``: all of the above, machine-readable.
 
 Every file is written atomically; a file that cannot be written is a :class:`ReportError`.
@@ -28,6 +31,7 @@ import argparse
 import json
 import logging
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +45,14 @@ from pegame.report.cells import (
     identity,
     other_factors,
     select,
+)
+from pegame.report.compare import (
+    CompareError,
+    compare,
+    file_stem,
+    parse_compare,
+    render_compare_csv,
+    render_compare_md,
 )
 from pegame.report.figures import figure_bytes, figures
 from pegame.report.hypotheses import (
@@ -72,8 +84,10 @@ from pegame.report.tables import (
 __all__ = [
     "ALPHA",
     "UNTESTED",
+    "CompareError",
     "ReportError",
     "bootstrap_ci",
+    "compare",
     "holm",
     "hypotheses",
     "load_sweep",
@@ -138,18 +152,29 @@ def aggregate(sweep: Sweep, dirs: list[Path]) -> tuple[dict[str, Any], list[Cell
 
 
 def write_report(
-    sweep_dirs: str | Path | list[str | Path], out_dir: str | Path | None = None
+    sweep_dirs: str | Path | list[str | Path],
+    out_dir: str | Path | None = None,
+    comparisons: Sequence[tuple[str, str, str]] = (),
 ) -> dict[str, Any]:
     """Aggregate one or more sweep directories and write the tables, figures,
     hypotheses.md and report.json into ``out_dir`` (default: the sweep directory; required
-    for several). Returns report.json's content."""
+    for several), and per (factor, A, B) of ``comparisons`` compare_<factor>.md / .csv
+    (:func:`~pegame.report.compare.compare`). Returns report.json's content."""
     dirs = [Path(d) for d in ([sweep_dirs] if isinstance(sweep_dirs, (str, Path)) else sweep_dirs)]
     if out_dir is None and len(dirs) != 1:
         raise ReportError(
             f"A report of {len(dirs)} sweep directories needs an output directory (--out)."
         )
     out = Path(out_dir) if out_dir is not None else dirs[0]
+    factors = [factor for factor, _, _ in comparisons]
+    twice = sorted({f for f in factors if factors.count(f) > 1})
+    if twice:
+        raise CompareError(
+            f"--compare names {', '.join(twice)} more than once: one comparison per factor "
+            f"(each writes compare_<factor>.md)."
+        )
     report, cells = aggregate(load_sweep(dirs), dirs)
+    report["comparisons"] = [compare(cells, *spec) for spec in comparisons]
     layout = Layout(cells, report["cells"])
     notes = render_provenance(report["provenance"]) + render_problems(problem_sections(report))
     files: dict[str, str | bytes] = {
@@ -158,6 +183,10 @@ def write_report(
         "table1.tex": render_table_tex(layout),
         "hypotheses.md": render_hypotheses(report["hypotheses"]),
     }
+    for comparison in report["comparisons"]:
+        stem = file_stem(comparison["factor"])
+        files[f"{stem}.md"] = render_compare_md(comparison)
+        files[f"{stem}.csv"] = render_compare_csv(comparison)
     for name, fig in figures(cells).items():
         for fmt in ("png", "svg"):
             files[f"{name}.{fmt}"] = figure_bytes(fig, fmt)
@@ -198,7 +227,20 @@ def main(argv: list[str] | None = None) -> int:
         default=None,
         help="output directory (default: the sweep directory; required for several)",
     )
+    parser.add_argument(
+        "--compare",
+        action="append",
+        default=[],
+        metavar="FACTOR=A,B",
+        help="compare value B of a factor (a setting that differs between the jobs) against "
+        "value A in every cell, paired on common seeds; writes compare_FACTOR.md/.csv "
+        "(repeatable, one per factor)",
+    )
     args = parser.parse_args(argv)
+    try:
+        comparisons = [parse_compare(text) for text in args.compare]
+    except CompareError as error:
+        parser.error(str(error))
     for directory in args.sweep_dirs:
         if not directory.is_dir():
             parser.error(f"not a directory: {directory}")
@@ -206,7 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("several sweep directories need --out")
     logging.basicConfig(level=logging.INFO, format="%(levelname)s: %(message)s")
     try:
-        report = write_report(args.sweep_dirs, args.out)
+        report = write_report(args.sweep_dirs, args.out, comparisons)
     except PegameError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
@@ -219,5 +261,15 @@ def main(argv: list[str] | None = None) -> int:
     for warning in report["provenance"]["warnings"]:
         print(f"WARNING: {warning}")
     for h in report["hypotheses"]:
-        print(f"{title(h)}: {h['summary']['text']}")
+        paired = h["summary_paired"]
+        print(
+            f"{title(h)}: {h['summary']['text']} by {h['test']}; "
+            f"{paired['text']} by {paired['test']}"
+        )
+    for c in report["comparisons"]:
+        s = c["summary"]
+        print(
+            f"{c['factor']}: {c['b']} against {c['a']}: significant in {s['significant']} of "
+            f"{s['tested']} tested cells -> {file_stem(c['factor'])}.md"
+        )
     return 0

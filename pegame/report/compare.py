@@ -1,0 +1,226 @@
+"""Compare two values of one factor, cell by cell, on common seeds (factor studies).
+
+A *factor* is a setting that differs between a sweep's configurations (see
+:mod:`pegame.report.cells`), e.g. ``detector.miss_probability``. :func:`compare` takes
+every cell of the paper's layout (environment x speed ratio v_p/v_e x pairing, and each
+combination of the sweep's *other* factors) where both values A and B of the factor have
+games, and compares B against A on the seeds they share (same seed, same spawn poses):
+n pairs, the mean of each side on those seeds, the mean difference B - A with its
+percentile-bootstrap CI over seeds, the rank-biserial correlation, and the two-sided
+Wilcoxon signed-rank test (Pratt's zeros, see :mod:`pegame.report.paired`),
+Holm-Bonferroni corrected across the comparison's tested cells. Rates are fractions in
+report.json and CSV, percent and percentage points in Markdown.
+
+From the command line: ``python -m pegame.report DIR ... --compare FACTOR=A,B`` writes
+``compare_<FACTOR>.md`` and ``compare_<FACTOR>.csv`` and adds the comparison to
+report.json's ``comparisons``. A and B are written as the report writes values (0.3,
+last_seen, true).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+from typing import Any
+
+from pegame.errors import PegameError
+from pegame.report.cells import Cell, value_text
+from pegame.report.paired import TEST_NAME, by_seed, difference_text, paired_test
+from pegame.report.statistics import ALPHA, holm
+from pegame.report.tables import csv_value, percent
+
+STATS = [
+    "n_a",
+    "n_b",
+    "n_pairs",
+    "mean_a",
+    "mean_b",
+    "mean_difference",
+    "ci_low",
+    "ci_high",
+    "zero_differences",
+    "rank_biserial",
+    "W",
+    "p",
+    "p_holm",
+]
+
+
+class CompareError(PegameError, ValueError):
+    """A comparison asked for a factor or a value that the sweep does not have."""
+
+
+def parse_compare(text: str) -> tuple[str, str, str]:
+    """'detector.miss_probability=0,0.3' as (factor, A, B)."""
+    factor, _, values = text.partition("=")
+    pair = values.split(",")
+    if not factor or len(pair) != 2 or not all(pair):
+        raise CompareError(
+            f"--compare {text!r} is not FACTOR=A,B. Give one setting that differs between "
+            f"the sweep's configurations and two of its values, e.g. "
+            f"--compare detector.miss_probability=0,0.3."
+        )
+    return factor, pair[0], pair[1]
+
+
+def file_stem(factor: str) -> str:
+    """'compare_detector.miss_probability' (characters unsafe in file names as '_')."""
+    return "compare_" + re.sub(r"[^\w.-]", "_", factor)
+
+
+def check(cells: list[Cell], factor: str, values: tuple[str, str]) -> None:
+    """Raise :class:`CompareError` unless ``factor`` is a factor of ``cells`` with both
+    ``values``."""
+    factors = list(cells[0].factors) if cells else []
+    if factor not in factors:
+        raise CompareError(
+            f"--compare: {factor!r} is not a factor of this sweep (a setting that differs "
+            f"between its configurations). Its factors: {', '.join(factors) or 'none'}."
+        )
+    seen = sorted({value_text(c.factors[factor]) for c in cells})
+    absent = [v for v in values if v not in seen]
+    if absent:
+        raise CompareError(
+            f"--compare {factor}: no games with {' or '.join(map(repr, absent))}. The values "
+            f"of {factor} in this sweep: {', '.join(seen)}."
+        )
+    if values[0] == values[1]:
+        raise CompareError(f"--compare {factor}: A and B are both {values[0]!r}; give two.")
+
+
+def compare(cells: list[Cell], factor: str, a: str, b: str) -> dict[str, Any]:
+    """Value ``b`` of ``factor`` against value ``a`` in every cell where both have games
+    (cells in table order): {factor, a, b, others, test, alpha, rows, summary}. A row has
+    the cell's map, speed_ratio, pairing and other ``factors``, n_a / n_b (all games of
+    each side), n_pairs, mean_a / mean_b on the common seeds, mean_difference (B - A) with
+    ci_low / ci_high, zero_differences, rank_biserial, W, p and p_holm; every statistic is
+    None when the two sides share no seed (not tested)."""
+    check(cells, factor, (a, b))
+    others = [f for f in cells[0].factors if f != factor]
+
+    def place(cell: Cell) -> tuple:
+        rest = tuple(cell.facet[i] for i, f in enumerate(cell.factors) if f != factor)
+        return cell.map, cell.speed_ratio, cell.pairing, rest
+
+    sides = {
+        value: {place(c): c for c in cells if value_text(c.factors[factor]) == value}
+        for value in (a, b)
+    }
+    rows = []
+    for key, cell_a in sides[a].items():
+        cell_b = sides[b].get(key)
+        if cell_b is None:
+            continue
+        test = paired_test(by_seed(cell_b.games), by_seed(cell_a.games), "two-sided")
+        rows.append(
+            {
+                "map": cell_a.map,
+                "speed_ratio": cell_a.speed_ratio,
+                "pairing": cell_a.pairing,
+                "factors": {f: cell_a.factors[f] for f in others},
+                "n_a": len(cell_a.games),
+                "n_b": len(cell_b.games),
+                **{k: v for k, v in test.items() if k not in ("mean_x", "mean_y")},
+                "mean_a": test["mean_y"],
+                "mean_b": test["mean_x"],
+                "p_holm": None,
+            }
+        )
+    tested = [row for row in rows if row["p"] is not None]
+    for row, adjusted in zip(tested, holm([row["p"] for row in tested])):
+        row["p_holm"] = adjusted
+    return {
+        "factor": factor,
+        "a": a,
+        "b": b,
+        "difference": "B - A",
+        "others": others,
+        "test": f"{TEST_NAME}, two-sided, Holm-Bonferroni across the tested cells",
+        "alpha": ALPHA,
+        "rows": rows,
+        "summary": {
+            "cells": len(rows),
+            "tested": len(tested),
+            "significant": sum(row["p_holm"] <= ALPHA for row in tested),
+        },
+    }
+
+
+def number(value: float | None, spec: str) -> str:
+    """A statistic for a table, '–' for None."""
+    return "–" if value is None else format(value, spec)
+
+
+def render_compare_md(comparison: dict[str, Any]) -> str:
+    """compare_<factor>.md: one table row per compared cell."""
+    factor, a, b = comparison["factor"], comparison["a"], comparison["b"]
+    header = [
+        *comparison["others"],
+        "environment",
+        "v_p/v_e",
+        "pairing",
+        "pairs",
+        f"mean ({a})",
+        f"mean ({b})",
+        f"{b} - {a} [CI]",
+        "rank-biserial r",
+        "W",
+        "p",
+        "p (Holm)",
+    ]
+    summary = comparison["summary"]
+    lines = [
+        f"# {factor}: {b} against {a}",
+        "",
+        "Per cell (environment x speed ratio x pairing"
+        + (", and the other factors" if comparison["others"] else "")
+        + f") where both {factor}={a} and {factor}={b} have games: the games on their common "
+        f"seeds (same spawn poses) are paired. Means on those seeds, the mean paired "
+        f"difference {b} - {a} in percentage points with its 95% percentile-bootstrap CI "
+        f"over seeds, the matched-pairs rank-biserial correlation, and the {TEST_NAME} "
+        f"(two-sided, zero_method='pratt'; W = T+, the sum of the ranks of the positive "
+        f"differences), Holm-Bonferroni corrected across the "
+        f"{summary['tested']} tested cells; alpha = {comparison['alpha']}. Significant in "
+        f"{summary['significant']} of {summary['tested']} tested cells ({summary['cells']} "
+        f"compared).",
+        "",
+        "| " + " | ".join(header) + " |",
+        "|" + "---|" * len(header),
+    ]
+    for row in comparison["rows"]:
+        texts = [
+            *(value_text(v) for v in row["factors"].values()),
+            row["map"],
+            f"{row['speed_ratio']:g}",
+            row["pairing"],
+            f"{row['n_pairs']} (of {row['n_a']}, {row['n_b']})",
+            percent(row["mean_a"]),
+            percent(row["mean_b"]),
+            difference_text(row),
+            number(row["rank_biserial"], "+.2f"),
+            number(row["W"], "g"),
+            number(row["p"], ".3g"),
+            number(row["p_holm"], ".3g"),
+        ]
+        lines.append("| " + " | ".join(texts) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def render_compare_csv(comparison: dict[str, Any]) -> str:
+    """compare_<factor>.csv: the other factors, map, speed_ratio, pairing, then
+    :data:`STATS`; rates as fractions, empty where not tested."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow([*comparison["others"], "map", "speed_ratio", "pairing", *STATS])
+    for row in comparison["rows"]:
+        writer.writerow(
+            [
+                *(csv_value(v) for v in row["factors"].values()),
+                row["map"],
+                row["speed_ratio"],
+                row["pairing"],
+                *("" if row[s] is None else row[s] for s in STATS),
+            ]
+        )
+    return buffer.getvalue()
