@@ -1,0 +1,211 @@
+"""Tests for the perception model (pegame.detectors.perception): each part off changes
+nothing, and each part on does what its config says, per second at any control rate."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pegame.api import Context
+from pegame.detectors.oracle import OracleDetector
+from pegame.detectors.perception import Perception, PerceptionConfig
+from pegame.errors import ConfigError
+from pegame.grid import FREE, OccupancyGrid
+from pegame.registry import make_config
+from pegame.types import Body, BoundingBox, Camera, Detection, Pose
+
+CAMERA = Camera()  # pi/3 FOV, 0.3-5 m, 640 x 480 px
+EVADER = Body(radius=0.25, v_max=0.5, w_max=1.8)
+ORIGIN = Pose(0.0, 0.0, 0.0)
+
+
+def context(hz: float = 10.0) -> Context:
+    grid = OccupancyGrid(np.full((10, 10), FREE, dtype=np.int8), 0.1)
+    return Context(grid, Body(0.2, 0.5, 1.8), EVADER, CAMERA, 1.0 / hz, 1.0)
+
+
+def perception(hz: float = 10.0, seed: int = 0, **params) -> Perception:
+    config = make_config("detector", OracleDetector, params)
+    return Perception(config, context(hz), np.random.default_rng(seed))
+
+
+def seen_at(x: float, y: float = 0.0, depth: float | None = None) -> Detection:
+    """A detection of an evader at (x, y) m seen from ORIGIN."""
+    box = BoundingBox(CAMERA.column_of(math.atan2(y, x)) - 10.0, 200.0, 20.0, 80.0)
+    return Detection(box=box, depth=x if depth is None else depth, position=(x, y))
+
+
+def run(model: Perception, ticks: int, capture, hz: float = 10.0) -> list:
+    """The detections delivered over ``ticks`` control ticks; ``capture(k)`` is the raw
+    detection of the frame captured at tick k."""
+    return [model.deliver(k / hz, ORIGIN, lambda k=k: capture(k)) for k in range(ticks)]
+
+
+def test_with_every_part_off_each_tick_delivers_its_own_capture_and_draws_nothing():
+    rng = np.random.default_rng(3)
+    model = Perception(PerceptionConfig(), context(), rng)
+    frames = [seen_at(2.0 + 0.01 * k) if k % 3 else None for k in range(50)]
+    assert run(model, 50, lambda k: frames[k]) == frames
+    assert rng.random() == np.random.default_rng(3).random()  # spawning leaves the stream
+
+
+@pytest.mark.parametrize(("rate", "every"), [(2.0, 5), (1.0, 10), (5.0, 2), (40.0, 1)])
+def test_a_rate_captures_every_one_over_rate_seconds_and_holds_the_result(rate, every):
+    captured = []
+    model = perception(rate=rate)
+
+    def capture(k):
+        captured.append(k)
+        return seen_at(1.0 + k)
+
+    delivered = run(model, 40, capture)
+    assert captured == list(range(0, 40, every))
+    assert [d.position[0] - 1.0 for d in delivered] == [k - k % every for k in range(40)]
+
+
+@pytest.mark.parametrize(
+    ("hz", "latency", "ticks"), [(10.0, 0.3, 3), (20.0, 0.3, 6), (5.0, 1.0, 5)]
+)
+def test_latency_delivers_each_result_that_many_ticks_later(hz, latency, ticks):
+    model = perception(hz, latency=latency)
+    delivered = run(model, 30, lambda k: seen_at(1.0 + k), hz)
+    assert delivered[:ticks] == [None] * ticks
+    assert [d.position[0] - 1.0 for d in delivered[ticks:]] == list(range(30 - ticks))
+
+
+def test_rate_and_latency_together_deliver_old_frames_at_the_rate():
+    delivered = run(perception(rate=1.0, latency=0.5), 30, lambda k: seen_at(1.0 + k))
+    frames = [None if d is None else d.position[0] - 1.0 for d in delivered]
+    assert frames == [None] * 5 + [0.0] * 10 + [10.0] * 10 + [20.0] * 5
+
+
+def bursts(missed: np.ndarray) -> np.ndarray:
+    """Lengths (frames) of the runs of True in ``missed``, the last unfinished one dropped."""
+    edges = np.diff(np.concatenate([[0], missed.astype(int), [0]]))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    lengths = ends - starts
+    return lengths[:-1] if missed[-1] else lengths
+
+
+@pytest.mark.parametrize("hz", [5.0, 10.0, 20.0])
+def test_bursty_misses_have_the_configured_fraction_and_burst_length_at_any_rate(hz):
+    fraction, length, seconds = 0.3, 1.5, 20000.0
+    model = perception(hz, seed=int(hz), burst_miss_fraction=fraction, burst_length=length)
+    n = int(seconds * hz)
+    missed = np.array([d is None for d in run(model, n, lambda k: seen_at(2.0), hz)])
+    # The chain's lag-one correlation is 1 - P(G->B) - P(B->G): the fraction's variance is
+    # the binomial one times (1 + c) / (1 - c) (the variance of a two-state Markov mean).
+    p_bg = (1.0 / hz) / length
+    p_gb = p_bg * fraction / (1 - fraction)
+    c = 1 - p_gb - p_bg
+    std = math.sqrt(fraction * (1 - fraction) / n * (1 + c) / (1 - c))
+    assert abs(missed.mean() - fraction) < 4 * std
+    runs = bursts(missed) / hz  # s; a burst's frames are geometric with mean 1 / P(B->G)
+    std = math.sqrt((1 - p_bg) / p_bg**2 / runs.size) / hz
+    assert abs(runs.mean() - length) < 4 * std
+
+
+def test_independent_misses_are_binomial():
+    n, p = 20000, 0.2
+    model = perception(miss_probability=p)
+    delivered = [model.degrade(seen_at(2.0), ORIGIN) for _ in range(n)]
+    missed = sum(d is None for d in delivered)
+    assert abs(missed / n - p) < 4 * math.sqrt(p * (1 - p) / n)
+
+
+def test_the_range_miss_grows_linearly_from_its_start_to_the_detection_range():
+    model = perception(miss_range_start=2.0, detection_range=4.0, miss_at_range=0.8)
+    chances = [model.miss_chance(r) for r in (1.0, 2.0, 3.0, 3.5, 4.0)]
+    assert chances == pytest.approx([0.0, 0.0, 0.4, 0.6, 0.8])
+    n = 20000
+    missed = sum(model.degrade(seen_at(3.0), ORIGIN) is None for _ in range(n))
+    assert abs(missed / n - 0.4) < 4 * math.sqrt(0.24 / n)
+    assert model.degrade(seen_at(4.2), ORIGIN) is None  # beyond the detection range
+
+
+def test_the_occlusion_miss_grows_with_the_hidden_fraction_and_combines_with_range():
+    model = perception(occlusion_miss=0.5, miss_range_start=2.0, detection_range=4.0)
+    assert model.miss_chance(1.0, hidden=0.4) == pytest.approx(0.2)
+    assert model.miss_chance(3.0, hidden=0.4) == pytest.approx(1 - 0.5 * 0.8)
+
+
+def test_depth_noise_grows_with_the_square_of_the_range():
+    a, b, n = 0.01, 0.004, 20000
+    model = perception(range_noise=a, range_noise_growth=b)
+    for r in (1.0, 4.0):
+        depths = np.array([model.degrade(seen_at(r), ORIGIN).depth for _ in range(n)])
+        expected = a + b * r**2
+        assert np.mean(depths) == pytest.approx(r, abs=4 * expected / math.sqrt(n))
+        # The sample std of n normals has a relative std of about 1 / sqrt(2 n).
+        assert np.std(depths) == pytest.approx(expected, rel=4 / math.sqrt(2 * n))
+
+
+def test_bearing_noise_turns_the_position_about_the_camera_and_shifts_the_box():
+    std, n = 0.05, 20000
+    model = perception(bearing_noise=std)
+    truth = seen_at(3.0, 0.5)
+    seen = [model.degrade(truth, ORIGIN) for _ in range(n)]
+    errors = np.array(
+        [math.atan2(s.position[1], s.position[0]) - math.atan2(0.5, 3.0) for s in seen]
+    )
+    assert np.std(errors) == pytest.approx(std, rel=4 / math.sqrt(2 * n))
+    assert all(math.hypot(*s.position) == pytest.approx(math.hypot(3.0, 0.5)) for s in seen[:50])
+    columns = np.array([s.box.center_x for s in seen[:50]])
+    bearings = np.arctan2(0.5, 3.0) + errors[:50]
+    assert columns == pytest.approx([CAMERA.column_of(b) for b in bearings])
+
+
+@pytest.mark.parametrize("hz", [5.0, 10.0, 20.0])
+def test_false_positives_arrive_at_their_rate_per_second_inside_the_view(hz):
+    rate, seconds = 0.5, 4000.0
+    model = perception(hz, seed=int(hz), false_positive_rate=rate, detection_range=4.0)
+    n = int(seconds * hz)
+    fakes = [d for d in run(model, n, lambda k: None, hz) if d is not None]
+    # A frame holds one when at least one arrived in its 1/hz s: a binomial count of frames.
+    p = -math.expm1(-rate / hz)
+    assert abs(len(fakes) - n * p) < 4 * math.sqrt(n * p * (1 - p))
+    assert len(fakes) / seconds == pytest.approx(rate, rel=0.1)  # about the Poisson rate
+    ranges = np.array([math.hypot(*f.position) for f in fakes])
+    bearings = np.array([math.atan2(f.position[1], f.position[0]) for f in fakes])
+    assert ranges.min() >= CAMERA.near and ranges.max() <= 4.0
+    assert np.abs(bearings).max() <= CAMERA.fov / 2
+    # Uniform over the wedge's area: P(r < R/2) = (R^2/4 - near^2) / (R^2 - near^2).
+    inner = (4.0 - CAMERA.near**2) / (16.0 - CAMERA.near**2)
+    assert abs(np.mean(ranges < 2.0) - inner) < 4 * math.sqrt(inner * (1 - inner) / len(fakes))
+    assert all(0 < f.box.w and 0 < f.box.h <= CAMERA.image_height for f in fakes)
+
+
+def test_a_detected_evader_is_reported_over_a_false_positive():
+    model = perception(false_positive_rate=1000.0)
+    truth = seen_at(2.0)
+    assert all(d is truth for d in run(model, 50, lambda k: truth))
+
+
+@pytest.mark.parametrize(
+    ("params", "key"),
+    [
+        ({"rate": 0.0}, "rate"),
+        ({"rate": -1.0}, "rate"),
+        ({"latency": -0.1}, "latency"),
+        ({"detection_range": 0.0}, "detection_range"),
+        ({"detection_range": 0.2}, "detection_range"),  # not past camera.near
+        ({"miss_probability": 1.5}, "miss_probability"),
+        ({"burst_miss_fraction": 1.0}, "burst_miss_fraction"),
+        ({"burst_length": 0.0}, "burst_length"),
+        ({"burst_miss_fraction": 0.3, "burst_length": 0.05}, "burst_length"),  # < a frame
+        ({"burst_miss_fraction": 0.3, "burst_length": 0.5, "rate": 1.0}, "burst_length"),
+        ({"miss_range_start": -1.0}, "miss_range_start"),
+        ({"miss_range_start": 5.0}, "miss_range_start"),  # not below the detection range
+        ({"miss_at_range": 2.0}, "miss_at_range"),
+        ({"occlusion_miss": -0.5}, "occlusion_miss"),
+        ({"range_noise": -0.1}, "range_noise"),
+        ({"range_noise_growth": math.inf}, "range_noise_growth"),
+        ({"bearing_noise": -0.1}, "bearing_noise"),
+        ({"false_positive_rate": -1.0}, "false_positive_rate"),
+    ],
+)
+def test_bad_values_name_their_detector_key(params, key):
+    with pytest.raises(ConfigError, match=f"detector.{key}"):
+        perception(**params)
