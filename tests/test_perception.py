@@ -209,3 +209,51 @@ def test_a_detected_evader_is_reported_over_a_false_positive():
 def test_bad_values_name_their_detector_key(params, key):
     with pytest.raises(ConfigError, match=f"detector.{key}"):
         perception(**params)
+
+
+# ------------------------------------------------- the particle filter's miss factor per second
+
+
+def pf_mass_in_view_after_a_second_of_misses(hz: float, **params) -> tuple[float, float]:
+    """(mass inside a view before, after one second of misses at ``hz``) for a particle
+    filter whose measurement alone acts (updates of dt 0, no resampling)."""
+    from pegame.estimators.particle_filter import ParticleFilter
+    from pegame.visibility import MaskRegion
+
+    grid = OccupancyGrid(np.full((40, 50), FREE, dtype=np.int8), 0.1)
+    ctx = Context(grid, Body(0.2, 0.5, 1.8), EVADER, CAMERA, 1.0 / hz, 1.0)
+    config = make_config("estimator", ParticleFilter, {"rho": 0.0, "init_spread": 0.5, **params})
+    pf = ParticleFilter(config, ctx, np.random.default_rng(5))
+    everywhere, right = np.ones((40, 50), bool), np.zeros((40, 50), bool)
+    right[:, 20:] = True  # x >= 2 m
+    belief = pf.reset(ORIGIN, seen_at(2.0, 2.0), MaskRegion(everywhere))
+    inside = belief.particles[:, 0] >= 2.0
+    before = belief.weights[inside].sum()
+    for _ in range(round(hz)):
+        belief = pf.update(0.0, ORIGIN, None, MaskRegion(right))
+    return before, belief.weights[belief.particles[:, 0] >= 2.0].sum()
+
+
+@pytest.mark.parametrize("hz", [5.0, 10.0, 20.0])
+def test_the_particle_filter_miss_factor_means_the_same_per_second_at_any_rate(hz):
+    factor = 0.05  # per 1/10 s by default: 0.05 ** 10 per second
+    before, after = pf_mass_in_view_after_a_second_of_misses(hz, miss_factor=factor)
+    per_second = factor**10
+    assert 0.1 < before < 0.9
+    assert after == pytest.approx(
+        per_second * before / (per_second * before + 1 - before), rel=1e-6
+    )
+    # Stated per second instead: one factor of 0.05 over the whole second.
+    before, after = pf_mass_in_view_after_a_second_of_misses(
+        hz, miss_factor=factor, miss_factor_hz=1.0
+    )
+    assert after == pytest.approx(factor * before / (factor * before + 1 - before), rel=1e-6)
+
+
+def test_the_particle_filter_miss_factor_at_10_hz_is_the_configured_factor_per_tick():
+    from pegame.estimators.particle_filter import ParticleFilter
+
+    config = make_config("estimator", ParticleFilter, {"miss_factor": 0.05})
+    assert ParticleFilter(config, context(10.0), np.random.default_rng(0))._miss_factor == 0.05
+    with pytest.raises(ConfigError, match="estimator.miss_factor_hz"):
+        make_config("estimator", ParticleFilter, {"miss_factor_hz": 0.0})
