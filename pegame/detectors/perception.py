@@ -150,7 +150,10 @@ class Perception:
 
     config: a :class:`PerceptionConfig`; context: the game's context (camera, control_dt,
     evader body); rng: the detector's generator, from which one generator per part is
-    spawned; body_height and camera_height (m): the box of a false positive.
+    spawned; body_height and camera_height (m): the box of a false positive; occlusion:
+    whether the detector reports the hidden fraction of the evader (simulator-side
+    geometric detectors); without it ``occlusion_miss`` must stay 0, as a rendering
+    detector's pixels already show the occlusion.
     """
 
     def __init__(
@@ -160,12 +163,19 @@ class Perception:
         rng: np.random.Generator,
         body_height: float = PERSON_HEIGHT,
         camera_height: float = 0.4,
+        occlusion: bool = True,
     ) -> None:
         self.config, self.context = config, context
         self.camera = context.camera
         self.body_height, self.camera_height = body_height, camera_height
         self.range = self.camera.far if config.detection_range is None else config.detection_range
         self._check(config)
+        if not occlusion and config.occlusion_miss > 0:
+            raise ConfigError(
+                f"Invalid value for 'detector.occlusion_miss': {config.occlusion_miss!r}. "
+                "Allowed: 0 for this detector, whose pixels already show what is hidden "
+                "(the occlusion miss is the oracle's, detector=oracle)."
+            )
         self.rngs = dict(zip(PARTS, rng.spawn(len(PARTS))))
         self.period = context.control_dt if config.rate is None else 1.0 / config.rate
         self.reset()
@@ -204,12 +214,18 @@ class Perception:
     # ---------------------------------------------------------------- the pipeline
 
     def deliver(
-        self, time: float, pose: Pose, capture: Callable[[], Detection | None]
+        self,
+        time: float,
+        pose: Pose,
+        capture: Callable[[], Detection | None],
+        camera_height: float | None = None,
     ) -> Detection | None:
         """The detection delivered at ``time`` (s) by a camera at ``pose``: ``capture()``
         (the detector's detection for the current frame) is called only when a frame is
         due; bursts and false positives are applied to it, and it is delivered ``latency``
-        s later; until then the previous result is held."""
+        s later; until then the previous result is held. ``camera_height`` (m) overrides
+        the one given at construction for this frame's false positive (a rendering
+        simulator's calibration knows it)."""
         if self._next_capture is None:
             self._next_capture = time
         if time >= self._next_capture - TIME_TOLERANCE:
@@ -218,7 +234,8 @@ class Perception:
             if self._burst_step(dt):
                 result = None
             if result is None:
-                result = self._false_positive(dt, pose)
+                height = self.camera_height if camera_height is None else camera_height
+                result = self._false_positive(dt, pose, height)
             self._pending.append((time + self.config.latency, result))
             self._last_capture = time
             if self.config.rate is None:
@@ -244,7 +261,7 @@ class Perception:
             self._bursting = draw < min(1.0, dt * f / (length * (1 - f)))
         return self._bursting
 
-    def _false_positive(self, dt: float, pose: Pose) -> Detection | None:
+    def _false_positive(self, dt: float, pose: Pose, camera_height: float) -> Detection | None:
         """A false detection when one arrived in the last ``dt`` s, else None."""
         rate = self.config.false_positive_rate
         if rate == 0:
@@ -257,9 +274,7 @@ class Perception:
         distance = math.sqrt(rng.uniform(camera.near**2, self.range**2))  # uniform over the area
         depth = max(camera.near, distance * math.cos(bearing))
         radius = self.context.evader.radius
-        box = pinhole_box(
-            camera, bearing, distance, depth, radius, self.body_height, self.camera_height
-        )
+        box = pinhole_box(camera, bearing, distance, depth, radius, self.body_height, camera_height)
         heading = pose.theta + bearing
         position = (pose.x + distance * math.cos(heading), pose.y + distance * math.sin(heading))
         return Detection(box=box, depth=depth, position=position)
