@@ -49,6 +49,15 @@ def test_with_every_part_off_each_tick_delivers_its_own_capture_and_draws_nothin
     frames = [seen_at(2.0 + 0.01 * k) if k % 3 else None for k in range(50)]
     assert run(model, 50, lambda k: frames[k]) == frames
     assert rng.random() == np.random.default_rng(3).random()  # spawning leaves the stream
+    assert all(model.degrade(frame, ORIGIN) is frame for frame in frames)
+
+
+def test_a_rate_that_does_not_divide_the_control_rate_captures_on_schedule_without_drift():
+    captured = []
+    run(perception(rate=3.0), 3001, lambda k: captured.append(k))
+    # Frames are due at n / 3 s; each is captured at the first tick at or after it.
+    assert captured == [math.ceil(n / 3 * 10 - 1e-6) for n in range(len(captured))]
+    assert len(captured) == 901
 
 
 @pytest.mark.parametrize(("rate", "every"), [(2.0, 5), (1.0, 10), (5.0, 2), (40.0, 1)])
@@ -257,3 +266,33 @@ def test_the_particle_filter_miss_factor_at_10_hz_is_the_configured_factor_per_t
     assert ParticleFilter(config, context(10.0), np.random.default_rng(0))._miss_factor == 0.05
     with pytest.raises(ConfigError, match="estimator.miss_factor_hz"):
         make_config("estimator", ParticleFilter, {"miss_factor_hz": 0.0})
+
+
+# ------------------------------------------------------------------------- in a game
+
+PAPER_LIKE = [
+    "detector.rate=1.0",
+    "detector.latency=0.5",
+    "detector.burst_miss_fraction=0.2",
+    "detector.burst_length=2.0",
+    "detector.miss_range_start=3.0",
+    "detector.range_noise=0.01",
+    "detector.range_noise_growth=0.002",
+    "detector.bearing_noise=0.02",
+    "detector.false_positive_rate=0.1",
+    "detector.occlusion_miss=0.5",
+]
+
+
+def play(overrides: list[str], seed: int = 0) -> dict:
+    from pegame.config import compose
+    from pegame.game import Game
+
+    base = ["env=enclosed", "game.t_max=10", "recorder=none", f"game.seed={seed}"]
+    return Game(compose([*base, *overrides])).play("unused").result
+
+
+def test_a_game_with_every_part_on_plays_the_same_for_the_same_seed_and_differs_from_the_oracle():
+    slow = play(PAPER_LIKE)
+    assert slow == play(PAPER_LIKE)
+    assert slow != play([])

@@ -205,7 +205,8 @@ class Perception:
 
     def reset(self) -> None:
         """Start a new game: empty pipeline, nothing held, the burst chain undrawn."""
-        self._next_capture: float | None = None
+        self._first_capture: float | None = None
+        self._captures = 0  # frames captured since the first, which fix the next one's time
         self._last_capture: float | None = None
         self._pending: deque[tuple[float, Detection | None]] = deque()
         self._held: Detection | None = None
@@ -226,9 +227,14 @@ class Perception:
         s later; until then the previous result is held. ``camera_height`` (m) overrides
         the one given at construction for this frame's false positive (a rendering
         simulator's calibration knows it)."""
-        if self._next_capture is None:
-            self._next_capture = time
-        if time >= self._next_capture - TIME_TOLERANCE:
+        if self._first_capture is None:
+            self._first_capture = time
+        # Without a rate every tick captures; with one, frames are due at whole periods
+        # from the first (counted, not summed, so the schedule does not drift).
+        due = self.config.rate is None or (
+            time >= self._first_capture + self._captures * self.period - TIME_TOLERANCE
+        )
+        if due:
             dt = self.period if self._last_capture is None else time - self._last_capture
             result = capture()
             if self._burst_step(dt):
@@ -238,11 +244,11 @@ class Perception:
                 result = self._false_positive(dt, pose, height)
             self._pending.append((time + self.config.latency, result))
             self._last_capture = time
-            if self.config.rate is None:
-                self._next_capture = time
-            else:
-                while self._next_capture <= time + TIME_TOLERANCE:  # catch up at high rates
-                    self._next_capture += self.period
+            while (
+                self.config.rate is not None
+                and self._first_capture + self._captures * self.period <= time + TIME_TOLERANCE
+            ):
+                self._captures += 1  # past this frame, and past the frames a high rate skips
         while self._pending and self._pending[0][0] <= time + TIME_TOLERANCE:
             self._held = self._pending.popleft()[1]
         return self._held
