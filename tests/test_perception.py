@@ -296,3 +296,21 @@ def test_a_game_with_every_part_on_plays_the_same_for_the_same_seed_and_differs_
     slow = play(PAPER_LIKE)
     assert slow == play(PAPER_LIKE)
     assert slow != play([])
+
+
+@pytest.mark.parametrize(
+    ("overrides", "key"),
+    [
+        (["detector.burst_miss_fraction=0.3", "detector.burst_length=0.05"], "burst_length"),
+        (["detector.detection_range=0.2"], "detection_range"),
+        (["detector.miss_range_start=6.0"], "miss_range_start"),
+    ],
+)
+def test_the_scenario_checks_what_needs_the_camera_and_the_control_rate_before_any_game(
+    overrides, key
+):
+    from pegame.config import compose
+    from pegame.game import Scenario
+
+    with pytest.raises(ConfigError, match=f"detector.{key}"):
+        Scenario(compose(["env=enclosed", *overrides]))

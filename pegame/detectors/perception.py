@@ -51,6 +51,7 @@ import math
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -69,7 +70,12 @@ PARTS = ("burst", "range", "bearing", "false_positive", "independent", "noise")
 @dataclass
 class PerceptionConfig:
     """Config mixin of the perception model's fields (module docstring), for a detector's
-    ``Config`` to inherit; every part is off by default."""
+    ``Config`` to inherit; every part is off by default. The checks that need the camera
+    and the control period are :meth:`check_context`, which the scenario calls once."""
+
+    # Whether the detector knows the evader's hidden fraction (a simulator-side geometric
+    # detector); a rendering detector sets it False, its pixels already showing occlusion.
+    occlusion: ClassVar[bool] = True
 
     rate: float | None = None  # Hz, results delivered per second (null: every control tick)
     latency: float = 0.0  # s, a result shows the world this long before its delivery
@@ -115,6 +121,41 @@ class PerceptionConfig:
             value = getattr(self, name)
             require(math.isfinite(value) and value >= 0, key(name), f"a number >= 0 {unit}", value)
 
+    def check_context(self, context) -> None:
+        """The checks that need the game's camera and control period (``context``): a
+        ConfigError naming the key."""
+        near, reach = context.camera.near, detection_range(self, context.camera)
+        if reach <= near:
+            raise ConfigError(
+                f"Invalid value for 'detector.detection_range': {self.detection_range!r}. "
+                f"Allowed: a range > camera.near ({near} m)."
+            )
+        start = self.miss_range_start
+        if start is not None and start >= reach:
+            raise ConfigError(
+                f"Invalid value for 'detector.miss_range_start': {start!r}. Allowed: a range "
+                f"below the detection range ({reach} m), or null for no range misses."
+            )
+        f, length = self.burst_miss_fraction, self.burst_length
+        step = max(context.control_dt, 0.0 if self.rate is None else 1.0 / self.rate)
+        if f > 0 and (length < step or length * (1 - f) / f < step):
+            raise ConfigError(
+                f"Invalid value for 'detector.burst_length': {length!r}. Allowed: bursts and "
+                f"the runs between them (burst_length * (1 - f) / f with f = "
+                f"detector.burst_miss_fraction = {f}) of at least one frame, {step:g} s."
+            )
+        if not self.occlusion and self.occlusion_miss > 0:
+            raise ConfigError(
+                f"Invalid value for 'detector.occlusion_miss': {self.occlusion_miss!r}. "
+                "Allowed: 0 for this detector, whose pixels already show what is hidden "
+                "(the occlusion miss is the oracle's, detector=oracle)."
+            )
+
+
+def detection_range(config: PerceptionConfig, camera) -> float:
+    """The detection range (m): ``detection_range``, or the camera's ``far`` when null."""
+    return camera.far if config.detection_range is None else config.detection_range
+
 
 def pinhole_box(camera, bearing, distance, depth, radius, height, camera_height) -> BoundingBox:
     """The image box (px) of an upright cylinder of ``radius`` and ``height`` m standing at
@@ -150,10 +191,7 @@ class Perception:
 
     config: a :class:`PerceptionConfig`; context: the game's context (camera, control_dt,
     evader body); rng: the detector's generator, from which one generator per part is
-    spawned; body_height and camera_height (m): the box of a false positive; occlusion:
-    whether the detector reports the hidden fraction of the evader (simulator-side
-    geometric detectors); without it ``occlusion_miss`` must stay 0, as a rendering
-    detector's pixels already show the occlusion.
+    spawned; body_height and camera_height (m): the box of a false positive.
     """
 
     def __init__(
@@ -163,45 +201,15 @@ class Perception:
         rng: np.random.Generator,
         body_height: float = PERSON_HEIGHT,
         camera_height: float = 0.4,
-        occlusion: bool = True,
     ) -> None:
+        config.check_context(context)
         self.config, self.context = config, context
         self.camera = context.camera
         self.body_height, self.camera_height = body_height, camera_height
-        self.range = self.camera.far if config.detection_range is None else config.detection_range
-        self._check(config)
-        if not occlusion and config.occlusion_miss > 0:
-            raise ConfigError(
-                f"Invalid value for 'detector.occlusion_miss': {config.occlusion_miss!r}. "
-                "Allowed: 0 for this detector, whose pixels already show what is hidden "
-                "(the occlusion miss is the oracle's, detector=oracle)."
-            )
+        self.range = detection_range(config, context.camera)
         self.rngs = dict(zip(PARTS, rng.spawn(len(PARTS))))
         self.period = context.control_dt if config.rate is None else 1.0 / config.rate
         self.reset()
-
-    def _check(self, config: PerceptionConfig) -> None:
-        """What needs the camera and the control period: a ConfigError naming the key."""
-        near = self.camera.near
-        if self.range <= near:
-            raise ConfigError(
-                f"Invalid value for 'detector.detection_range': {config.detection_range!r}. "
-                f"Allowed: a range > camera.near ({near} m)."
-            )
-        start = config.miss_range_start
-        if start is not None and start >= self.range:
-            raise ConfigError(
-                f"Invalid value for 'detector.miss_range_start': {start!r}. Allowed: a range "
-                f"below the detection range ({self.range} m), or null for no range misses."
-            )
-        f, length = config.burst_miss_fraction, config.burst_length
-        step = max(self.context.control_dt, 0.0 if config.rate is None else 1.0 / config.rate)
-        if f > 0 and (length < step or length * (1 - f) / f < step):
-            raise ConfigError(
-                f"Invalid value for 'detector.burst_length': {length!r}. Allowed: bursts and "
-                f"the runs between them (burst_length * (1 - f) / f with f = "
-                f"detector.burst_miss_fraction = {f}) of at least one frame, {step:g} s."
-            )
 
     def reset(self) -> None:
         """Start a new game: empty pipeline, nothing held, the burst chain undrawn."""

@@ -26,6 +26,7 @@ Needs a simulator that renders segmentation (``sim=pybullet``); imports no pybul
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -64,6 +65,8 @@ class SegmentationDetector(Detector):
 
     @dataclass
     class Config(PerceptionConfig):
+        # The rendered pixels already show occlusion: no occlusion miss here.
+        occlusion: ClassVar[bool] = False
         min_pixels: int = 5  # fewer evader pixels than this: not detected
         surface_offset: float = 0.12  # m from the evader's visible surface to its axis
 
@@ -81,7 +84,7 @@ class SegmentationDetector(Detector):
 
     def __init__(self, config, context, rng) -> None:
         super().__init__(config, context, rng)
-        self.perception = Perception(config, context, rng, occlusion=False)
+        self.perception = Perception(config, context, rng)
 
     def reset(self) -> None:
         self.perception.reset()

@@ -31,6 +31,7 @@ already shows what is hidden.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -54,6 +55,8 @@ class VisionDetector(Detector):
 
     @dataclass
     class Config(PerceptionConfig):
+        # The rendered pixels already show occlusion: no occlusion miss here.
+        occlusion: ClassVar[bool] = False
         colours: list[str] = field(
             default_factory=lambda: list(EVADER_COLOURS)
         )  # '#rrggbb', the evader's
@@ -118,7 +121,7 @@ class VisionDetector(Detector):
             config.colours, config.hue_tolerance, config.min_saturation, config.min_value
         )
         self.tracker = BoxTracker(config.max_features)
-        self.perception = Perception(config, context, rng, occlusion=False)
+        self.perception = Perception(config, context, rng)
         self.reset()
 
     def reset(self) -> None:
