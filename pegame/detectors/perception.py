@@ -2,8 +2,9 @@
 noise, false positives and a detection range, every rate per second (s, m, rad; map frame).
 
 A real person detector is not a perfect oracle at the control rate: the paper's pursuer
-ran a person detector on a TurtleBot 2's depth camera at about 1 Hz (paper, Secs.
-"Simulation setup" and "Object tracking from static camera"). Every part below is off by
+detected the evader with OpenPose, tracked it with Lucas-Kanade and placed it with a
+TurtleBot's RGB-D camera, its nodes running at 1 Hz (paper, Secs. "Object tracking from
+static camera" and "Simulation based validation"). Every part below is off by
 default, and a part that is off draws no random number, so today's games are unchanged.
 Each part draws from its own generator, spawned from the detector's (``Generator.spawn``
 leaves the detector's own stream as it was), so turning one part on does not change
