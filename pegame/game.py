@@ -151,6 +151,10 @@ class Scenario:
             control_dt=1.0 / self.settings.control_hz,
             decision_dt=1.0 / self.settings.decision_hz,
         )
+        for config in self.configs.values():  # the checks that need the camera or the rates
+            check_context = getattr(config, "check_context", None)
+            if check_context is not None:
+                check_context(self.context)
         self.config = OmegaConf.to_container(cfg, resolve=True)
 
     def game(self, seed: int) -> Game:

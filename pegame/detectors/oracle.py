@@ -10,6 +10,14 @@ image size (square pixels) mounted ``camera_height`` above the floor. Depth is t
 along the optical axis to the evader's axis, optionally with Gaussian noise; the map
 position is back-projected from the box centre's bearing and that depth, as a depth
 camera would (paper, Sec. "Object tracking from static camera").
+
+Every part of the perception model (:mod:`pegame.detectors.perception`) applies: rate and
+latency, the detection range, independent misses, bursty (Gilbert-Elliott) misses, misses
+growing with range and with the hidden fraction of the evader's silhouette, depth noise
+growing with range (Khoshelham & Elberink 2012) and bearing noise, both entering before
+the box is drawn, and false positives. The independent miss and the depth noise draw from
+the detector's own generator, two numbers for every evader in view, as they always have;
+the other parts from their own generators, only when they are on.
 """
 
 from __future__ import annotations
@@ -18,8 +26,9 @@ import math
 from dataclasses import dataclass
 
 from pegame.api import Detector
+from pegame.detectors.perception import Perception, PerceptionConfig, hidden_fraction, pinhole_box
 from pegame.errors import require
-from pegame.types import BoundingBox, Detection, SensorFrame, wrap_angle
+from pegame.types import Detection, SensorFrame, wrap_angle
 from pegame.visibility import in_view
 
 
@@ -29,13 +38,12 @@ class OracleDetector(Detector):
     description = "Geometric detection (FOV, range, line of sight) with a synthetic pinhole box."
 
     @dataclass
-    class Config:
+    class Config(PerceptionConfig):
         evader_height: float = 1.7  # m, height of the evader's cylinder
         camera_height: float = 0.4  # m, camera height above the floor
-        range_noise: float = 0.0  # m, std of the depth noise
-        miss_probability: float = 0.0  # chance that a visible evader goes undetected
 
         def __post_init__(self) -> None:
+            super().__post_init__()
             for key in ("evader_height", "camera_height"):
                 require(
                     getattr(self, key) > 0,
@@ -43,34 +51,51 @@ class OracleDetector(Detector):
                     "a positive height in m",
                     getattr(self, key),
                 )
-            require(self.range_noise >= 0, "detector.range_noise", "a std >= 0 m", self.range_noise)
-            require(
-                0 <= self.miss_probability <= 1,
-                "detector.miss_probability",
-                "[0, 1]",
-                self.miss_probability,
-            )
+
+    def __init__(self, config, context, rng) -> None:
+        super().__init__(config, context, rng)
+        self.perception = Perception(
+            config, context, rng, config.evader_height, config.camera_height
+        )
+
+    def reset(self) -> None:
+        self.perception.reset()
 
     def detect(self, frame: SensorFrame) -> Detection | None:
+        return self.perception.deliver(frame.time, frame.camera_pose, lambda: self._capture(frame))
+
+    def _capture(self, frame: SensorFrame) -> Detection | None:
+        """The detection of this frame, before the pipeline (rate, latency, bursts, false
+        positives)."""
         cam, evader = frame.camera_pose, frame.evader_truth
-        camera, cfg = self.context.camera, self.config
+        camera, cfg, perception = self.context.camera, self.config, self.perception
         if evader is None or not in_view(self.context.grid, camera, cam, (evader.x, evader.y)):
+            return None
+        distance = cam.distance_to(evader)
+        if not perception.in_range(distance):
             return None
         # Draw both numbers every time so the random stream does not depend on outcomes.
         miss, noise = self.rng.random(), self.rng.normal(0.0, 1.0)
         if miss < cfg.miss_probability:
             return None
-        distance = cam.distance_to(evader)
+        if perception.misses_by_range_or_occlusion:
+            hidden = 0.0
+            if cfg.occlusion_miss > 0:
+                grid, radius = self.context.grid, self.context.evader.radius
+                hidden = hidden_fraction(grid, camera, cam, (evader.x, evader.y), radius)
+            if perception.missed_by_range(distance, hidden):
+                return None
         bearing = math.atan2(evader.y - cam.y, evader.x - cam.x) - cam.theta
         bearing = wrap_angle(bearing)
-        half = math.asin(min(1.0, self.context.evader.radius / distance))
-        left = max(0.0, camera.column_of(bearing + half))
-        right = min(float(camera.image_width), camera.column_of(bearing - half))
-        depth = max(camera.near, distance * math.cos(bearing) + cfg.range_noise * noise)
-        focal, cy = camera.focal_px, 0.5 * camera.image_height
-        top = max(0.0, cy - focal * (cfg.evader_height - cfg.camera_height) / depth)
-        bottom = min(float(camera.image_height), cy + focal * cfg.camera_height / depth)
-        box = BoundingBox(left, top, right - left, bottom - top)
+        if cfg.bearing_noise > 0:
+            bearing += perception.bearing_error()
+        depth = max(
+            camera.near, distance * math.cos(bearing) + perception.depth_std(distance) * noise
+        )
+        radius = self.context.evader.radius
+        box = pinhole_box(
+            camera, bearing, distance, depth, radius, cfg.evader_height, cfg.camera_height
+        )
         seen_bearing = camera.bearing_of(box.center_x)
         seen_range = depth / math.cos(seen_bearing)
         heading = cam.theta + seen_bearing

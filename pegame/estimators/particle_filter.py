@@ -12,8 +12,11 @@ every control tick, the pursuer's detection (or None) and visibility region V_k^
   and moves for dt seconds along the heading at the middle of the step.
 - Measurement model: with a detection at z (map frame, m), w_i *= exp(-|p_i - z|^2 /
   (2 sigma^2)) and the particles in_region (their cell inside V_k^p) are multiplied by
-  in_region_boost; without one, the particles in_region are multiplied by miss_factor
-  (negative information: the evader would have been detected there). Particles in blocked
+  in_region_boost; without one, the particles in_region are multiplied by
+  miss_factor ** (control_dt * miss_factor_hz) (negative information: the evader would
+  have been detected there), i.e. by miss_factor per 1 / miss_factor_hz s, so the evidence
+  of a second without detections is the same at any game.control_hz (at the default 10 Hz
+  and control_hz 10, exactly miss_factor per tick). Particles in blocked
   cells (occupied or unknown) or off the grid get weight 0. Weights are then normalised to
   sum to 1.
 - Degeneracy, the paper's Eq. for the effective sample size: N_eff = 1 / sum_i w_i^2. When
@@ -225,6 +228,7 @@ class ParticleFilter(Estimator):
             2.0  # weight factor (>= 1) inside the visible region on a detection
         )
         miss_factor: float = 0.05  # weight factor in [0, 1] inside the visible region on a miss
+        miss_factor_hz: float = 10.0  # Hz, the rate miss_factor is the factor per tick at
         init_spread: float = 0.3  # m, std of the initial cloud around the first detection
 
         def __post_init__(self) -> None:
@@ -239,6 +243,8 @@ class ParticleFilter(Estimator):
             boost = self.in_region_boost
             require(boost >= 1.0, key("in_region_boost"), "a factor >= 1", boost)
             require(0.0 <= self.miss_factor <= 1.0, key("miss_factor"), "[0, 1]", self.miss_factor)
+            hz = self.miss_factor_hz
+            require(math.isfinite(hz) and hz > 0, key("miss_factor_hz"), "a rate > 0 Hz", hz)
             require(self.init_spread >= 0.0, key("init_spread"), "a std >= 0 m", self.init_spread)
             for name in ("sigma", "turn_rate_std", "in_region_boost", "init_spread"):
                 value = getattr(self, name)
@@ -251,6 +257,8 @@ class ParticleFilter(Estimator):
         self._free_cells = np.flatnonzero(~self._blocked)
         if self._free_cells.size == 0:
             raise MapError(f"Map '{grid.name}' has no free cell for the particle filter to use.")
+        # The miss factor per control tick, stated per second in the config (module docstring).
+        self._miss_factor = config.miss_factor ** (context.control_dt * config.miss_factor_hz)
         n = config.n_particles
         self.particles = np.zeros((n, 3))
         self.weights = np.full(n, 1.0 / n)
@@ -350,7 +358,7 @@ class ParticleFilter(Estimator):
             likelihood,
             detection is not None,
             cfg.in_region_boost,
-            cfg.miss_factor,
+            self._miss_factor,
         )
         return moved, weights, total, evidence, n_eff
 
@@ -366,7 +374,7 @@ class ParticleFilter(Estimator):
         in_region = on_grid & self._flat_mask(visible.mask)[flat]
         if detection is None:
             evidence = 0.0
-            factor = np.where(in_region, cfg.miss_factor, 1.0)
+            factor = np.where(in_region, self._miss_factor, 1.0)
         else:
             likelihood = self._likelihood(moved, detection.position) * valid
             evidence = float(np.dot(self.weights, likelihood))

@@ -14,16 +14,24 @@ With fewer than ``min_pixels`` of them there is no detection. Otherwise (paper, 
   the evader's visible surface, so it is moved ``surface_offset`` m further along the
   horizontal ray from the camera, to the evader's axis.
 
+The perception model (:mod:`pegame.detectors.perception`) applies to these detections:
+rate and latency, the detection range, independent, bursty and range misses, depth noise
+growing with range (Khoshelham & Elberink 2012), bearing noise and false positives, all
+off by default; not the occlusion miss (``occlusion_miss`` must stay 0), since the
+rendered pixels already show what is hidden.
+
 Needs a simulator that renders segmentation (``sim=pybullet``); imports no pybullet.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from pegame.api import Detector
+from pegame.detectors.perception import Perception, PerceptionConfig
 from pegame.errors import ConfigError, require
 from pegame.types import BoundingBox, Detection, SensorFrame
 
@@ -56,11 +64,14 @@ class SegmentationDetector(Detector):
     )
 
     @dataclass
-    class Config:
+    class Config(PerceptionConfig):
+        # The rendered pixels already show occlusion: no occlusion miss here.
+        occlusion: ClassVar[bool] = False
         min_pixels: int = 5  # fewer evader pixels than this: not detected
         surface_offset: float = 0.12  # m from the evader's visible surface to its axis
 
         def __post_init__(self) -> None:
+            super().__post_init__()
             require(
                 self.min_pixels >= 1, "detector.min_pixels", "a whole number >= 1", self.min_pixels
             )
@@ -71,7 +82,24 @@ class SegmentationDetector(Detector):
                 self.surface_offset,
             )
 
+    def __init__(self, config, context, rng) -> None:
+        super().__init__(config, context, rng)
+        self.perception = Perception(config, context, rng)
+
+    def reset(self) -> None:
+        self.perception.reset()
+
     def detect(self, frame: SensorFrame) -> Detection | None:
+        pose = frame.camera_pose
+        return self.perception.deliver(
+            frame.time,
+            pose,
+            lambda: self.perception.degrade(self._see(frame), pose),
+            camera_height=None if frame.camera_to_map is None else float(frame.camera_to_map[2, 3]),
+        )
+
+    def _see(self, frame: SensorFrame) -> Detection | None:
+        """The evader's detection in this frame's segmentation, before the perception model."""
         if frame.segmentation is None or frame.labels is None or "evader" not in frame.labels:
             raise ConfigError(
                 "detector=segmentation needs a simulator that renders a segmentation mask with an "

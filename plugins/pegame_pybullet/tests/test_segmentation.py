@@ -89,3 +89,32 @@ def test_frames_without_segmentation_are_a_clear_error(context):
     )
     with pytest.raises(ConfigError, match="sim=pybullet"):
         detector.detect(SensorFrame(time=0.0, camera_pose=Pose(0, 0), evader_truth=Pose(1, 0)))
+
+
+def test_the_perception_model_holds_delays_and_degrades_segmentation_detections(scene, context):
+    """Rate 1 Hz and latency 0.2 s at 10 Hz: the frame of tick 0 arrives at tick 2 and is
+    held until the frame of tick 10 arrives at tick 12; depth noise moves it along its ray."""
+    sim, exact = scene
+    config = SegmentationDetector.Config(rate=1.0, latency=0.2, range_noise=0.05)
+    slow = SegmentationDetector(config, context, np.random.default_rng(0))
+    delivered, raw = [], []
+    for k in range(14):
+        sim.reset(Pose(0.3, 1.0, 0.0), Pose(1.2 + 0.02 * k, 1.0, 0.0))
+        frame = sim.sense(0.1 * k)
+        delivered.append(slow.detect(frame))
+        raw.append(exact.detect(frame))
+    assert delivered[:2] == [None, None]
+    assert all(d is delivered[2] for d in delivered[2:12]) and delivered[12] is delivered[13]
+    assert delivered[12] is not delivered[2]
+    for seen, truth in ((delivered[2], raw[0]), (delivered[12], raw[10])):
+        assert seen.depth != truth.depth
+        bearing = math.atan2(seen.position[1] - 1.0, seen.position[0] - 0.3)
+        assert bearing == pytest.approx(
+            math.atan2(truth.position[1] - 1.0, truth.position[0] - 0.3)
+        )
+
+
+def test_the_occlusion_miss_is_refused_for_segmentation(context):
+    config = SegmentationDetector.Config(occlusion_miss=0.5)
+    with pytest.raises(ConfigError, match="detector.occlusion_miss"):
+        SegmentationDetector(config, context, np.random.default_rng(0))

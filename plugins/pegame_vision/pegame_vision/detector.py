@@ -19,15 +19,24 @@ horizontal) are dropped. The depth is the samples' median depth (m along the opt
 axis), the position their median map (x, y) moved ``surface_offset`` m further from the
 camera, from the body's visible surface to its axis. Boxes are reported in the pursuer
 camera's ``image_width`` x ``image_height`` frame.
+
+The perception model (:mod:`pegame.detectors.perception`) applies to these detections:
+rate (the colour model and the tracker then see only the frames the pipeline captures)
+and latency, the detection range, independent, bursty and range misses, depth noise
+growing with range (Khoshelham & Elberink 2012), bearing noise and false positives, all
+off by default; not the occlusion miss (``occlusion_miss`` must stay 0), since the image
+already shows what is hidden.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
 from pegame.api import Detector
+from pegame.detectors.perception import Perception, PerceptionConfig
 from pegame.errors import ConfigError, require
 from pegame.types import BoundingBox, Detection, SensorFrame
 from pegame_vision.colour import ColourModel, find_blobs, parse_hex
@@ -45,7 +54,9 @@ class VisionDetector(Detector):
     description = "OpenCV on RGB-D: colour model of the evader's clothing, Lucas-Kanade tracking."
 
     @dataclass
-    class Config:
+    class Config(PerceptionConfig):
+        # The rendered pixels already show occlusion: no occlusion miss here.
+        occlusion: ClassVar[bool] = False
         colours: list[str] = field(
             default_factory=lambda: list(EVADER_COLOURS)
         )  # '#rrggbb', the evader's
@@ -62,6 +73,7 @@ class VisionDetector(Detector):
         surface_offset: float = 0.12  # m from the evader's visible surface to its axis
 
         def __post_init__(self) -> None:
+            super().__post_init__()
             require(
                 len(self.colours) > 0,
                 "detector.colours",
@@ -109,6 +121,7 @@ class VisionDetector(Detector):
             config.colours, config.hue_tolerance, config.min_saturation, config.min_value
         )
         self.tracker = BoxTracker(config.max_features)
+        self.perception = Perception(config, context, rng)
         self.reset()
 
     def reset(self) -> None:
@@ -116,18 +129,30 @@ class VisionDetector(Detector):
         self._since_detection = 0
         self._frame: SensorFrame | None = None
         self._last: Detection | None = None
+        self._delivered: Detection | None = None
         self.source: str | None = None  # how the last detection was made: "detect" or "track"
+        self.perception.reset()
 
     def detect(self, frame: SensorFrame) -> Detection | None:
         if frame is self._frame:  # the simulator reused its last frame: nothing new to see
-            return self._last
+            return self._delivered
+        self._frame, pose = frame, frame.camera_pose
+        self._delivered = self.perception.deliver(
+            frame.time,
+            pose,
+            lambda: self.perception.degrade(self._see(frame), pose),
+            camera_height=None if frame.camera_to_map is None else float(frame.camera_to_map[2, 3]),
+        )
+        return self._delivered
+
+    def _see(self, frame: SensorFrame) -> Detection | None:
+        """This frame's detection by colour or tracking, before the perception model."""
         needed = (frame.rgb, frame.depth, frame.intrinsics, frame.camera_to_map)
         if any(value is None for value in needed):
             raise ConfigError(
                 "detector=vision needs RGB-D frames with the camera calibration (sim=pybullet); "
                 "use detector=oracle with sim=grid."
             )
-        self._frame = frame
         gray = cv2.cvtColor(frame.rgb, cv2.COLOR_RGB2GRAY)
         samples, source = (self._track(frame, gray) if self._tracking else None), "track"
         if samples is None:

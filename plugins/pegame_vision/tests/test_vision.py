@@ -106,3 +106,20 @@ def test_missing_opencv_is_an_import_error_naming_it():
     error = missing_dependency_error("detector", "vision", "cv2", "pegame_vision")
     assert "cv2" in str(error) and "pip install opencv-python-headless" in str(error)
     assert isinstance(error.__cause__, ImportError)
+
+
+def test_at_a_lower_rate_the_colour_model_sees_only_the_captured_frames(walk):
+    """Rate 2 Hz at 10 Hz: a detection per 0.5 s, held in between, each made on the
+    frame the pipeline captured, as the same detector would make it on those frames alone."""
+    context, frames = walk
+    slow = run(context, frames, rate=2.0)
+    captured = run(context, frames[::5])
+    for k, (detection, _) in enumerate(slow):
+        assert detection == captured[k // 5][0]
+        assert detection is slow[k - k % 5][0]
+
+
+def test_the_occlusion_miss_is_refused_for_vision(context):
+    config = VisionDetector.Config(occlusion_miss=0.5)
+    with pytest.raises(ConfigError, match="detector.occlusion_miss"):
+        VisionDetector(config, context, np.random.default_rng(0))

@@ -1,0 +1,366 @@
+"""The perception model a detector's raw detections go through: rate, latency, misses,
+noise, false positives and a detection range, every rate per second (s, m, rad; map frame).
+
+A real person detector is not a perfect oracle at the control rate: the paper's pursuer
+detected the evader with OpenPose, tracked it with Lucas-Kanade and placed it with a
+TurtleBot's RGB-D camera, its nodes running at 1 Hz (paper, Secs. "Object tracking from
+static camera" and "Simulation based validation"). Every part below is off by
+default, and a part that is off draws no random number, so today's games are unchanged.
+Each part draws from its own generator, spawned from the detector's (``Generator.spawn``
+leaves the detector's own stream as it was), so turning one part on does not change
+another's draws.
+
+- Pipeline (:meth:`Perception.deliver`): a frame is captured every 1/``rate`` s (every
+  control tick when ``rate`` is null) and its result is delivered ``latency`` s later, so a
+  result shows the world as it was ``latency`` s before; between deliveries the latest
+  result (a detection or None) is held.
+- Independent misses: each captured detection is lost with ``miss_probability``.
+- Bursty misses, the two-state Markov chain of Gilbert (1960) and Elliott (1963): a
+  detector state G (detects) or B (misses), stepped at each capture with the time
+  dt (s) since the last one by P(G->B) = dt f / (L (1 - f)) and P(B->G) = dt / L, where f is
+  ``burst_miss_fraction`` and L is ``burst_length``. Its stationary miss fraction is
+  P(G->B) / (P(G->B) + P(B->G)) = f and a burst lasts 1 / P(B->G) frames, L s on average,
+  at any control or capture rate. The first frame draws its state from the stationary law.
+- Range and occlusion misses: a detection at range r (m) is lost with
+  p = 1 - (1 - p_r)(1 - p_o), p_r = ``miss_at_range`` * clip((r - r0) / (R - r0), 0, 1) from
+  r0 = ``miss_range_start`` to the detection range R, and p_o = ``occlusion_miss`` * h, h the
+  fraction of the evader's silhouette points (:data:`pegame.visibility.SILHOUETTE`) not in
+  view (:func:`hidden_fraction`; simulator-side detectors with the true evader only).
+- Depth noise, the structured-light (Kinect) model of Khoshelham & Elberink (2012,
+  "Accuracy and resolution of Kinect depth data for indoor mapping applications",
+  Sensors 12(2)), whose random depth error grows with the square of the range:
+  std = ``range_noise`` + ``range_noise_growth`` * r^2 (m); bearing noise of std
+  ``bearing_noise`` (rad).
+- False positives: a Poisson process of ``false_positive_rate`` false detections per
+  second; a frame whose evader is not detected holds one when at least one arrived since
+  the last frame (chance 1 - exp(-rate * dt)), placed uniformly over the field-of-view
+  wedge between the camera's near range and the detection range (occlusion ignored), with
+  the pinhole box of a person there (:func:`pinhole_box`). A frame where the evader is
+  detected reports the evader (a single-target detector reports its best candidate).
+- Detection range: nothing beyond ``detection_range`` m (null: the camera's ``far``) is
+  detected.
+
+Only the detector knows what its raw detection is; it calls :meth:`Perception.deliver`
+with a function that captures one (applying the per-detection parts: range, misses,
+noise, through :meth:`Perception.degrade` or the building blocks), and the pipeline adds
+rate, latency, bursts and false positives.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from pegame.errors import ConfigError, require
+from pegame.types import BoundingBox, Detection, Pose, wrap_angle
+from pegame.visibility import SILHOUETTE, in_view
+
+#: s; times this close count as equal (capture and delivery schedules)
+TIME_TOLERANCE = 1e-9
+#: m, height of the person a false positive is drawn as when the detector has no evader model
+PERSON_HEIGHT = 1.7
+#: the generators the parts draw from, one each, spawned from the detector's in this order
+PARTS = ("burst", "range", "bearing", "false_positive", "independent", "noise")
+
+
+@dataclass
+class PerceptionConfig:
+    """Config mixin of the perception model's fields (module docstring), for a detector's
+    ``Config`` to inherit; every part is off by default. The checks that need the camera
+    and the control period are :meth:`check_context`, which the scenario calls once."""
+
+    # Whether the detector knows the evader's hidden fraction (a simulator-side geometric
+    # detector); a rendering detector sets it False, its pixels already showing occlusion.
+    occlusion: ClassVar[bool] = True
+
+    rate: float | None = None  # Hz, results delivered per second (null: every control tick)
+    latency: float = 0.0  # s, a result shows the world this long before its delivery
+    detection_range: float | None = None  # m, farthest detection (null: the camera's far)
+    miss_probability: float = 0.0  # chance that a detection is missed, independently per frame
+    burst_miss_fraction: float = 0.0  # long-run fraction of frames missed in bursts, in [0, 1)
+    burst_length: float = 1.0  # s, mean length of a burst of misses
+    miss_range_start: float | None = None  # m, range where misses start to grow (null: off)
+    miss_at_range: float = 1.0  # miss chance at the detection range, with miss_range_start
+    occlusion_miss: float = 0.0  # miss chance per hidden fraction of the silhouette, in [0, 1]
+    range_noise: float = 0.0  # m, depth noise std at range 0 (a in a + b * range^2)
+    range_noise_growth: float = 0.0  # 1/m, depth noise std growth (b in a + b * range^2)
+    bearing_noise: float = 0.0  # rad, std of the bearing noise
+    false_positive_rate: float = 0.0  # 1/s, false detections per second (Poisson)
+
+    def __post_init__(self) -> None:
+        key = "detector.{}".format
+        if self.rate is not None:
+            ok = math.isfinite(self.rate) and self.rate > 0
+            require(ok, key("rate"), "a rate > 0 Hz, or null for every control tick", self.rate)
+        ok = math.isfinite(self.latency) and self.latency >= 0
+        require(ok, key("latency"), "a delay >= 0 s", self.latency)
+        if self.detection_range is not None:
+            ok = math.isfinite(self.detection_range) and self.detection_range > 0
+            allowed = "a range > 0 m, or null for the camera's far"
+            require(ok, key("detection_range"), allowed, self.detection_range)
+        for name in ("miss_probability", "miss_at_range", "occlusion_miss"):
+            require(0 <= getattr(self, name) <= 1, key(name), "[0, 1]", getattr(self, name))
+        fraction = self.burst_miss_fraction
+        require(0 <= fraction < 1, key("burst_miss_fraction"), "[0, 1)", fraction)
+        ok = math.isfinite(self.burst_length) and self.burst_length > 0
+        require(ok, key("burst_length"), "a duration > 0 s", self.burst_length)
+        if self.miss_range_start is not None:
+            ok = math.isfinite(self.miss_range_start) and self.miss_range_start >= 0
+            allowed = "a range >= 0 m, or null for no range misses"
+            require(ok, key("miss_range_start"), allowed, self.miss_range_start)
+        for name, unit in (
+            ("range_noise", "m"),
+            ("range_noise_growth", "1/m"),
+            ("bearing_noise", "rad"),
+            ("false_positive_rate", "1/s"),
+        ):
+            value = getattr(self, name)
+            require(math.isfinite(value) and value >= 0, key(name), f"a number >= 0 {unit}", value)
+
+    def check_context(self, context) -> None:
+        """The checks that need the game's camera and control period (``context``): a
+        ConfigError naming the key."""
+        near, reach = context.camera.near, detection_range(self, context.camera)
+        if reach <= near:
+            raise ConfigError(
+                f"Invalid value for 'detector.detection_range': {self.detection_range!r}. "
+                f"Allowed: a range > camera.near ({near} m)."
+            )
+        start = self.miss_range_start
+        if start is not None and start >= reach:
+            raise ConfigError(
+                f"Invalid value for 'detector.miss_range_start': {start!r}. Allowed: a range "
+                f"below the detection range ({reach} m), or null for no range misses."
+            )
+        f, length = self.burst_miss_fraction, self.burst_length
+        step = max(context.control_dt, 0.0 if self.rate is None else 1.0 / self.rate)
+        if f > 0 and (length < step or length * (1 - f) / f < step):
+            raise ConfigError(
+                f"Invalid value for 'detector.burst_length': {length!r}. Allowed: bursts and "
+                f"the runs between them (burst_length * (1 - f) / f with f = "
+                f"detector.burst_miss_fraction = {f}) of at least one frame, {step:g} s."
+            )
+        if not self.occlusion and self.occlusion_miss > 0:
+            raise ConfigError(
+                f"Invalid value for 'detector.occlusion_miss': {self.occlusion_miss!r}. "
+                "Allowed: 0 for this detector, whose pixels already show what is hidden "
+                "(the occlusion miss is the oracle's, detector=oracle)."
+            )
+
+
+def detection_range(config: PerceptionConfig, camera) -> float:
+    """The detection range (m): ``detection_range``, or the camera's ``far`` when null."""
+    return camera.far if config.detection_range is None else config.detection_range
+
+
+def pinhole_box(camera, bearing, distance, depth, radius, height, camera_height) -> BoundingBox:
+    """The image box (px) of an upright cylinder of ``radius`` and ``height`` m standing at
+    ``distance`` m (horizontal, to its axis) and ``bearing`` rad (left of the optical axis),
+    ``depth`` m along the axis, seen by the pinhole ``camera`` mounted ``camera_height`` m
+    above the floor; clipped to the image."""
+    half = math.asin(min(1.0, radius / distance))
+    left = max(0.0, camera.column_of(bearing + half))
+    right = min(float(camera.image_width), camera.column_of(bearing - half))
+    focal, cy = camera.focal_px, 0.5 * camera.image_height
+    top = max(0.0, cy - focal * (height - camera_height) / depth)
+    bottom = min(float(camera.image_height), cy + focal * camera_height / depth)
+    return BoundingBox(left, top, right - left, bottom - top)
+
+
+def hidden_fraction(grid, camera, pose: Pose, centre_xy, radius: float) -> float:
+    """The fraction in [0, 1] of the silhouette points of a body (an upright cylinder of
+    ``radius`` m at the map-frame point ``centre_xy``) that the camera at ``pose`` does not
+    see: the same points, across the line of sight, as :func:`pegame.visibility.body_in_view`."""
+    x, y = float(centre_xy[0]), float(centre_xy[1])
+    dx, dy = x - pose.x, y - pose.y
+    distance = math.hypot(dx, dy)
+    across = (-dy / distance, dx / distance) if distance > 0.0 else (0.0, 0.0)
+    hidden = sum(
+        not in_view(grid, camera, pose, (x + k * radius * across[0], y + k * radius * across[1]))
+        for k in SILHOUETTE
+    )
+    return hidden / len(SILHOUETTE)
+
+
+class Perception:
+    """One detector's perception model (module docstring) for one game at a time.
+
+    config: a :class:`PerceptionConfig`; context: the game's context (camera, control_dt,
+    evader body); rng: the detector's generator, from which one generator per part is
+    spawned; body_height and camera_height (m): the box of a false positive.
+    """
+
+    def __init__(
+        self,
+        config: PerceptionConfig,
+        context,
+        rng: np.random.Generator,
+        body_height: float = PERSON_HEIGHT,
+        camera_height: float = 0.4,
+    ) -> None:
+        config.check_context(context)
+        self.config, self.context = config, context
+        self.camera = context.camera
+        self.body_height, self.camera_height = body_height, camera_height
+        self.range = detection_range(config, context.camera)
+        self.rngs = dict(zip(PARTS, rng.spawn(len(PARTS))))
+        self.period = context.control_dt if config.rate is None else 1.0 / config.rate
+        self.reset()
+
+    def reset(self) -> None:
+        """Start a new game: empty pipeline, nothing held, the burst chain undrawn."""
+        self._first_capture: float | None = None
+        self._captures = 0  # frames captured since the first, which fix the next one's time
+        self._last_capture: float | None = None
+        self._pending: deque[tuple[float, Detection | None]] = deque()
+        self._held: Detection | None = None
+        self._bursting: bool | None = None
+
+    # ---------------------------------------------------------------- the pipeline
+
+    def deliver(
+        self,
+        time: float,
+        pose: Pose,
+        capture: Callable[[], Detection | None],
+        camera_height: float | None = None,
+    ) -> Detection | None:
+        """The detection delivered at ``time`` (s) by a camera at ``pose``: ``capture()``
+        (the detector's detection for the current frame) is called only when a frame is
+        due; bursts and false positives are applied to it, and it is delivered ``latency``
+        s later; until then the previous result is held. ``camera_height`` (m) overrides
+        the one given at construction for this frame's false positive (a rendering
+        simulator's calibration knows it)."""
+        if self._first_capture is None:
+            self._first_capture = time
+        # Without a rate every tick captures; with one, frames are due at whole periods
+        # from the first (counted, not summed, so the schedule does not drift).
+        due = self.config.rate is None or (
+            time >= self._first_capture + self._captures * self.period - TIME_TOLERANCE
+        )
+        if due:
+            dt = self.period if self._last_capture is None else time - self._last_capture
+            result = capture()
+            if self._burst_step(dt):
+                result = None
+            if result is None:
+                height = self.camera_height if camera_height is None else camera_height
+                result = self._false_positive(dt, pose, height)
+            self._pending.append((time + self.config.latency, result))
+            self._last_capture = time
+            while (
+                self.config.rate is not None
+                and self._first_capture + self._captures * self.period <= time + TIME_TOLERANCE
+            ):
+                self._captures += 1  # past this frame, and past the frames a high rate skips
+        while self._pending and self._pending[0][0] <= time + TIME_TOLERANCE:
+            self._held = self._pending.popleft()[1]
+        return self._held
+
+    def _burst_step(self, dt: float) -> bool:
+        """Step the Gilbert-Elliott chain over ``dt`` s; True when this frame is missed."""
+        f, length = self.config.burst_miss_fraction, self.config.burst_length
+        if f == 0:
+            return False
+        draw = self.rngs["burst"].random()
+        if self._bursting is None:
+            self._bursting = draw < f  # the stationary law
+        elif self._bursting:
+            self._bursting = draw >= min(1.0, dt / length)
+        else:
+            self._bursting = draw < min(1.0, dt * f / (length * (1 - f)))
+        return self._bursting
+
+    def _false_positive(self, dt: float, pose: Pose, camera_height: float) -> Detection | None:
+        """A false detection when one arrived in the last ``dt`` s, else None."""
+        rate = self.config.false_positive_rate
+        if rate == 0:
+            return None
+        rng = self.rngs["false_positive"]
+        if rng.random() >= -math.expm1(-rate * dt):
+            return None
+        camera = self.camera
+        bearing = rng.uniform(-0.5 * camera.fov, 0.5 * camera.fov)
+        distance = math.sqrt(rng.uniform(camera.near**2, self.range**2))  # uniform over the area
+        depth = max(camera.near, distance * math.cos(bearing))
+        radius = self.context.evader.radius
+        box = pinhole_box(camera, bearing, distance, depth, radius, self.body_height, camera_height)
+        heading = pose.theta + bearing
+        position = (pose.x + distance * math.cos(heading), pose.y + distance * math.sin(heading))
+        return Detection(box=box, depth=depth, position=position)
+
+    # ---------------------------------------------------- per-detection building blocks
+
+    def in_range(self, distance: float) -> bool:
+        """Whether a body ``distance`` m away (horizontal) is within the detection range."""
+        return distance <= self.range
+
+    def depth_std(self, distance: float) -> float:
+        """Std (m) of the depth noise at ``distance`` m: range_noise + range_noise_growth * r^2."""
+        return self.config.range_noise + self.config.range_noise_growth * distance**2
+
+    def miss_chance(self, distance: float, hidden: float = 0.0) -> float:
+        """The range and occlusion miss chance at ``distance`` m with a ``hidden`` fraction of
+        the silhouette out of view: 1 - (1 - p_r)(1 - p_o) (module docstring)."""
+        cfg, p_range = self.config, 0.0
+        if cfg.miss_range_start is not None:
+            ramp = (distance - cfg.miss_range_start) / (self.range - cfg.miss_range_start)
+            p_range = cfg.miss_at_range * min(1.0, max(0.0, ramp))
+        return 1.0 - (1.0 - p_range) * (1.0 - cfg.occlusion_miss * hidden)
+
+    @property
+    def misses_by_range_or_occlusion(self) -> bool:
+        """Whether the range or the occlusion miss is on."""
+        return self.config.miss_range_start is not None or self.config.occlusion_miss > 0
+
+    def missed_by_range(self, distance: float, hidden: float = 0.0) -> bool:
+        """Draw the range and occlusion miss (no draw when both are off)."""
+        if not self.misses_by_range_or_occlusion:
+            return False
+        return bool(self.rngs["range"].random() < self.miss_chance(distance, hidden))
+
+    def bearing_error(self) -> float:
+        """A bearing error (rad), 0.0 without a draw when bearing noise is off."""
+        if self.config.bearing_noise == 0:
+            return 0.0
+        return float(self.rngs["bearing"].normal(0.0, self.config.bearing_noise))
+
+    def degrade(self, detection: Detection | None, pose: Pose) -> Detection | None:
+        """A detector's own detection through the per-detection parts, for detectors that
+        measure rather than simulate (segmentation, vision): the detection range, the
+        independent and range misses, depth noise (the range from the camera at ``pose``
+        scaled by the noisy depth over the measured one) and bearing noise (the position
+        turned about the camera, the box shifted to the new bearing's column)."""
+        if detection is None:
+            return None
+        cfg = self.config
+        dx, dy = detection.position[0] - pose.x, detection.position[1] - pose.y
+        distance = math.hypot(dx, dy)
+        if not self.in_range(distance):
+            return None
+        if cfg.miss_probability > 0 and self.rngs["independent"].random() < cfg.miss_probability:
+            return None
+        if self.missed_by_range(distance):
+            return None
+        std, error = self.depth_std(distance), self.bearing_error()
+        if std == 0 and error == 0:
+            return detection
+        depth = detection.depth
+        if std > 0:
+            depth = max(self.camera.near, depth + std * float(self.rngs["noise"].normal()))
+        scale = depth / detection.depth if detection.depth > 0 else 1.0
+        heading = math.atan2(dy, dx) + error
+        position = (
+            pose.x + scale * distance * math.cos(heading),
+            pose.y + scale * distance * math.sin(heading),
+        )
+        bearing = wrap_angle(heading - error - pose.theta)
+        shift = self.camera.column_of(bearing + error) - self.camera.column_of(bearing)
+        box = detection.box
+        box = BoundingBox(box.x + shift, box.y, box.w, box.h)
+        return Detection(box=box, depth=depth, position=position, confidence=detection.confidence)
