@@ -15,13 +15,14 @@ evader is told the pursuer's pose; the estimator never sees the true evader pose
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 
 import numpy as np
 
-from pegame.errors import require
+from pegame.errors import ConfigError, require
 from pegame.types import (
     EMPTY_BELIEF,
     STOP,
@@ -178,7 +179,19 @@ class Simulator(Plugin):
     @abstractmethod
     def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
         """Advance dt seconds with both commands held; commands beyond an agent's limits
-        are saturated, and an agent never enters an obstacle (it stops at the wall)."""
+        are saturated (speed, turn rate and, when finite, the bodies' ``a_max`` and
+        ``alpha_max``), and an agent never enters an obstacle (it stops at the wall)."""
+
+    def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
+        """Advance only ``role`` ('pursuer' or 'evader') dt seconds with ``cmd`` held, the
+        other agent paused (its pose and velocity kept): the turns of
+        ``game.turn_order=evader_first``. Simulators that cannot pause one agent keep this
+        default, which refuses that turn order."""
+        raise ConfigError(
+            f"game.turn_order=evader_first needs a simulator that moves one agent at a time; "
+            f"{type(self).__name__} does not (it has no step_one). Use "
+            f"game.turn_order=simultaneous or the grid simulator (sim=grid)."
+        )
 
     @property
     @abstractmethod
@@ -255,9 +268,11 @@ class Pursuer(Strategy):
     class Config:
         radius: float = 0.2  # body radius (m), a TurtleBot 2
         w_max: float = 1.8  # max turn rate (rad/s)
+        a_max: float = math.inf  # max change of speed (m/s^2) the simulator applies; .inf: at once
+        alpha_max: float = math.inf  # max change of turn rate (rad/s^2); .inf: at once
 
         def __post_init__(self) -> None:
-            for key in ("radius", "w_max"):
+            for key in ("radius", "w_max", "a_max", "alpha_max"):
                 value = getattr(self, key)
                 require(value > 0, f"pursuer.{key}", "a positive number", value)
 
@@ -274,9 +289,11 @@ class Evader(Strategy):
         radius: float = 0.25  # body radius (m), a person
         v_max: float = 0.5  # max speed (m/s); the pursuer's is game.speed_ratio times this
         w_max: float = 1.8  # max turn rate (rad/s)
+        a_max: float = math.inf  # max change of speed (m/s^2) the simulator applies; .inf: at once
+        alpha_max: float = math.inf  # max change of turn rate (rad/s^2); .inf: at once
 
         def __post_init__(self) -> None:
-            for key in ("radius", "v_max", "w_max"):
+            for key in ("radius", "v_max", "w_max", "a_max", "alpha_max"):
                 value = getattr(self, key)
                 require(value > 0, f"evader.{key}", "a positive number", value)
 
