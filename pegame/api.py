@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 
 import numpy as np
 
-from pegame.errors import ConfigError, require
+from pegame.errors import require
 from pegame.types import (
     EMPTY_BELIEF,
     STOP,
@@ -185,13 +185,9 @@ class Simulator(Plugin):
     def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
         """Advance only ``role`` ('pursuer' or 'evader') dt seconds with ``cmd`` held, the
         other agent paused (its pose and velocity kept): the turns of
-        ``game.turn_order=evader_first``. Simulators that cannot pause one agent keep this
-        default, which refuses that turn order."""
-        raise ConfigError(
-            f"game.turn_order=evader_first needs a simulator that moves one agent at a time; "
-            f"{type(self).__name__} does not (it has no step_one). Use "
-            f"game.turn_order=simultaneous or the grid simulator (sim=grid)."
-        )
+        ``game.turn_order=evader_first``. Optional: the tick loop refuses that turn order
+        for a simulator that keeps this default."""
+        raise NotImplementedError(f"{type(self).__name__} cannot move one agent at a time.")
 
     @property
     @abstractmethod

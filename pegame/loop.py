@@ -41,7 +41,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from pegame.api import Context, EvaderObservation, Plugin, PursuerObservation, Tick
+from pegame.api import (
+    Context,
+    EvaderObservation,
+    Plugin,
+    PursuerObservation,
+    Simulator,
+    Tick,
+)
 from pegame.config import TURN_ORDERS
 from pegame.errors import ConfigError
 from pegame.metrics import TrackingMetrics
@@ -82,6 +89,12 @@ class TickLoop:
                 f"game.turn_order=evader_first cannot have external roles {list(external)}: "
                 "the pursuer commands after seeing the evader's move, inside one tick. Use "
                 "game.turn_order=simultaneous with the environments."
+            )
+        if turn_order == "evader_first" and type(plugins["sim"]).step_one is Simulator.step_one:
+            raise ConfigError(
+                f"game.turn_order=evader_first needs a simulator that moves one agent at a "
+                f"time (Simulator.step_one); {type(plugins['sim']).__name__} does not. Use "
+                "game.turn_order=simultaneous, or the grid simulator (sim=grid)."
             )
         if substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps}.")

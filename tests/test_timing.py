@@ -99,6 +99,8 @@ def test_commands_held_over_substeps_drive_the_path_of_the_fast_control_rate(eva
     coarse = poses_every(constant_game([*common, "game.control_hz=1"], evader=evader))
     assert held == fast
     assert coarse != fast  # 1 s steps cut the arcs' chords and stop short of walls
+    stopped = [a[0] == b[0] for a, b in zip(held, held[1:])]
+    assert any(stopped) and not all(stopped)  # the straight drive did reach a wall
 
 
 @settings(max_examples=25, deadline=None)
@@ -146,10 +148,12 @@ def test_whole_multiples_of_the_control_rate_are_substeps():
     assert GameConfig(control_hz=3.0, physics_hz=3.0).substeps == 1
 
 
-def test_the_pybullet_sim_refuses_acceleration_limits():
+def test_the_pybullet_sim_refuses_acceleration_limits_and_turns():
     pytest.importorskip("pegame_pybullet")
     with pytest.raises(ConfigError, match=r"pursuer\.a_max"):
         Game(compose([*SHORT, "sim=pybullet", "pursuer.a_max=1.0"]))
+    with pytest.raises(ConfigError, match="step_one"):
+        Game(compose([*SHORT, "sim=pybullet", "game.turn_order=evader_first"])).start()
 
 
 def accelerating_sim(a_max=0.5, alpha_max=1.0):
@@ -252,9 +256,8 @@ def test_evader_first_refuses_external_roles_and_sims_without_step_one():
             return self.inner.sense(time)
 
     game.plugins["sim"] = BothOnly(game.plugins["sim"])
-    loop = game.start()
     with pytest.raises(ConfigError, match="step_one"):
-        loop.advance()
+        game.start()
 
 
 def test_the_tick_loop_takes_whole_substeps_only():
