@@ -131,7 +131,8 @@ class Tick:
     step: control tick index; time (s); pursuer, evader: true poses; frame: the sensor
     frame; detection or None; belief; region: the pursuer's visibility region (None when not computed);
     in_view: ground-truth visibility of the evader; commands: (pursuer, evader) velocities
-    applied after this tick; plans: the latest (pursuer, evader) plans.
+    applied after this tick (with ``game.turn_order=evader_first`` the evader's was applied
+    just before it, see :mod:`pegame.loop`); plans: the latest (pursuer, evader) plans.
     """
 
     step: int
