@@ -15,6 +15,7 @@ evader is told the pursuer's pose; the estimator never sees the true evader pose
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
@@ -130,7 +131,8 @@ class Tick:
     step: control tick index; time (s); pursuer, evader: true poses; frame: the sensor
     frame; detection or None; belief; region: the pursuer's visibility region (None when not computed);
     in_view: ground-truth visibility of the evader; commands: (pursuer, evader) velocities
-    applied after this tick; plans: the latest (pursuer, evader) plans.
+    applied after this tick (with ``game.turn_order=evader_first`` the evader's was applied
+    just before it, see :mod:`pegame.loop`); plans: the latest (pursuer, evader) plans.
     """
 
     step: int
@@ -178,7 +180,15 @@ class Simulator(Plugin):
     @abstractmethod
     def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
         """Advance dt seconds with both commands held; commands beyond an agent's limits
-        are saturated, and an agent never enters an obstacle (it stops at the wall)."""
+        are saturated (speed, turn rate and, when finite, the bodies' ``a_max`` and
+        ``alpha_max``), and an agent never enters an obstacle (it stops at the wall)."""
+
+    def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
+        """Advance only ``role`` ('pursuer' or 'evader') dt seconds with ``cmd`` held, the
+        other agent paused (its pose and velocity kept): the turns of
+        ``game.turn_order=evader_first``. Optional: the tick loop refuses that turn order
+        for a simulator that keeps this default."""
+        raise NotImplementedError(f"{type(self).__name__} cannot move one agent at a time.")
 
     @property
     @abstractmethod
@@ -255,9 +265,11 @@ class Pursuer(Strategy):
     class Config:
         radius: float = 0.2  # body radius (m), a TurtleBot 2
         w_max: float = 1.8  # max turn rate (rad/s)
+        a_max: float = math.inf  # max change of speed (m/s^2) the simulator applies; .inf: at once
+        alpha_max: float = math.inf  # max change of turn rate (rad/s^2); .inf: at once
 
         def __post_init__(self) -> None:
-            for key in ("radius", "w_max"):
+            for key in ("radius", "w_max", "a_max", "alpha_max"):
                 value = getattr(self, key)
                 require(value > 0, f"pursuer.{key}", "a positive number", value)
 
@@ -274,9 +286,11 @@ class Evader(Strategy):
         radius: float = 0.25  # body radius (m), a person
         v_max: float = 0.5  # max speed (m/s); the pursuer's is game.speed_ratio times this
         w_max: float = 1.8  # max turn rate (rad/s)
+        a_max: float = math.inf  # max change of speed (m/s^2) the simulator applies; .inf: at once
+        alpha_max: float = math.inf  # max change of turn rate (rad/s^2); .inf: at once
 
         def __post_init__(self) -> None:
-            for key in ("radius", "v_max", "w_max"):
+            for key in ("radius", "v_max", "w_max", "a_max", "alpha_max"):
                 value = getattr(self, key)
                 require(value > 0, f"evader.{key}", "a positive number", value)
 

@@ -29,6 +29,10 @@ from pegame.api import PLUGIN_KINDS
 from pegame.errors import ConfigError, require
 from pegame.types import Camera
 
+#: game.turn_order: both agents move in every simulator step, or the paper's "First the
+#: evader moves and then pursuer moves" (see :mod:`pegame.loop`)
+TURN_ORDERS = ("simultaneous", "evader_first")
+
 
 @dataclass
 class GameConfig:
@@ -40,6 +44,10 @@ class GameConfig:
     decision_hz: float = 1.0  # both strategies decide at this rate (Hz), the paper's 1 Hz nodes
     speed_ratio: float = 1.0  # v_p / v_e: the pursuer's max speed is this times evader.v_max
     trials: int = 1  # games per job, seeds seed, seed+1, ...; each appends a line to results.jsonl
+    physics_hz: float | None = (
+        None  # simulator integration rate (Hz), a whole multiple of control_hz; null: control_hz
+    )
+    turn_order: str = "simultaneous"  # simultaneous, or evader_first: each tick the evader moves, then the pursuer
 
     def __post_init__(self) -> None:
         require(
@@ -62,6 +70,28 @@ class GameConfig:
             f"a rate no higher than game.control_hz ({self.control_hz} Hz)",
             self.decision_hz,
         )
+        require(
+            self.turn_order in TURN_ORDERS,
+            "game.turn_order",
+            " or ".join(TURN_ORDERS),
+            self.turn_order,
+        )
+        if self.physics_hz is not None:
+            require(
+                self.physics_hz > 0 and math.isfinite(self.physics_hz),
+                "game.physics_hz",
+                "null (= game.control_hz) or a positive number",
+                self.physics_hz,
+            )
+            substeps = self.physics_hz / self.control_hz
+            multiples = ", ".join(f"{self.control_hz * k:.6g}" for k in range(1, 6))
+            require(
+                substeps >= 1 - 1e-9 and abs(substeps - round(substeps)) <= 1e-6 * substeps,
+                "game.physics_hz",
+                f"null or a whole multiple of game.control_hz={self.control_hz:g}: {multiples}, ... Hz "
+                "(each control tick is integrated in whole substeps)",
+                self.physics_hz,
+            )
         ratio = self.control_hz / self.decision_hz
         whole = ", ".join(f"{self.control_hz / k:.6g}" for k in range(1, 7))
         require(
@@ -76,6 +106,13 @@ class GameConfig:
     def ticks(self) -> int:
         """Control ticks in one game: ``t_max * control_hz``, rounded."""
         return int(round(self.t_max * self.control_hz))
+
+    @property
+    def substeps(self) -> int:
+        """Simulator steps per control tick: ``physics_hz / control_hz`` (1 when null)."""
+        if self.physics_hz is None:
+            return 1
+        return max(1, int(round(self.physics_hz / self.control_hz)))
 
     @property
     def decide_every(self) -> int:

@@ -144,9 +144,19 @@ class Scenario:
         self.context = Context(
             grid=grid,
             pursuer=Body(
-                pursuer_cfg.radius, self.settings.speed_ratio * evader_cfg.v_max, pursuer_cfg.w_max
+                pursuer_cfg.radius,
+                self.settings.speed_ratio * evader_cfg.v_max,
+                pursuer_cfg.w_max,
+                pursuer_cfg.a_max,
+                pursuer_cfg.alpha_max,
             ),
-            evader=Body(evader_cfg.radius, evader_cfg.v_max, evader_cfg.w_max),
+            evader=Body(
+                evader_cfg.radius,
+                evader_cfg.v_max,
+                evader_cfg.w_max,
+                evader_cfg.a_max,
+                evader_cfg.alpha_max,
+            ),
             camera=camera,
             control_dt=1.0 / self.settings.control_hz,
             decision_dt=1.0 / self.settings.decision_hz,
@@ -192,7 +202,14 @@ class Game:
         """Spawn both agents and return the game's tick loop at tick 0 (see TickLoop)."""
         settings = self.scenario.settings
         loop = TickLoop(
-            self.plugins, self.context, settings.ticks, settings.decide_every, external, estimate
+            self.plugins,
+            self.context,
+            settings.ticks,
+            settings.decide_every,
+            external,
+            estimate,
+            substeps=settings.substeps,
+            turn_order=settings.turn_order,
         )
         loop.start(*spawn(self.context, self.spawn_rng))
         return loop

@@ -59,11 +59,15 @@ STOP = Velocity(0.0, 0.0)
 
 @dataclass(frozen=True)
 class Body:
-    """An agent's physical limits: disc radius (m), max speed (m/s), max turn rate (rad/s)."""
+    """An agent's physical limits: disc radius (m), max speed (m/s), max turn rate (rad/s),
+    and the simulator's acceleration limits on its speed (m/s^2) and turn rate (rad/s^2);
+    infinite acceleration (the default) means a command takes effect at once."""
 
     radius: float
     v_max: float
     w_max: float
+    a_max: float = math.inf
+    alpha_max: float = math.inf
 
 
 @dataclass(frozen=True)

@@ -1,9 +1,20 @@
-"""Random navigation, the paper's baseline behaviour for both agents.
+"""Random behaviour, the paper's baseline for both agents (paper, Sec. "Random Pursuer
+and Evader"), in the two readings of the paper's text that ``model`` chooses between.
 
-An agent picks a goal uniformly at random among the free cells it can reach, plans a path
-to it (:class:`pegame.navigation.Planner`) and follows it; it picks a new goal when it
-arrives or when it has been stuck (moved less than ``stuck_distance`` m over a decision
-period) for ``stuck_decisions`` decisions in a row.
+- ``waypoint`` (:class:`Wanderer`): "we make use of move_base package for path planning
+  given a goal location to either the pursuer or evader", and the random pursuer "wanders
+  on the map with the hope of detecting an evader". An agent picks a goal uniformly at
+  random among the free cells it can reach, plans a path to it
+  (:class:`pegame.navigation.Planner`) and follows it; it picks a new goal when it arrives
+  or when it has been stuck (moved less than ``stuck_distance`` m over a decision period)
+  for ``stuck_decisions`` decisions in a row.
+- ``action`` (:class:`RandomActions`): Fig. 1, "The transparent arrows represent the
+  possible random actions the agents can take", in a game "played in discrete intervals of
+  1 unit each" by nodes "with a rate of 1Hz". At each decision the agent draws one action,
+  a unicycle command (the paper's agents are unicycles that "cannot translate sideways"):
+  forward speed v uniform in [0, v_max] (m/s) and turn rate w uniform in [-w_max, w_max]
+  (rad/s) of its body, and holds it until the next decision (an arc of one decision
+  period, an arrow of Fig. 1); a wall stops it there until the next draw.
 """
 
 from __future__ import annotations
@@ -12,6 +23,9 @@ import numpy as np
 
 from pegame.navigation import PathFollower, Planner
 from pegame.types import STOP, Body, Plan, Pose, Velocity
+
+#: the random agents' ``model`` values, in the order of the module docstring
+MODELS = ("waypoint", "action")
 
 
 class Wanderer:
@@ -62,3 +76,32 @@ class Wanderer:
         result = self.planner.plan((pose.x, pose.y), goal)
         self.follower.set_path(result.path)
         return Plan(goal=goal, path=result.path) if result.reachable else Plan()
+
+
+class RandomActions:
+    """A random action at each decision for an agent with ``body``, drawing from ``rng``:
+    (v, w) uniform in [0, v_max] x [-w_max, w_max], held until the next decision."""
+
+    def __init__(self, body: Body, rng: np.random.Generator) -> None:
+        self.body = body
+        self.rng = rng
+        self.action = STOP
+
+    def reset(self, pose: Pose) -> None:
+        self.action = STOP
+
+    def decide(self, pose: Pose) -> Plan:
+        v = float(self.rng.uniform(0.0, self.body.v_max))
+        w = float(self.rng.uniform(-self.body.w_max, self.body.w_max))
+        self.action = Velocity(v, w)
+        return Plan(info={"action_v": v, "action_w": w})
+
+    def control(self, pose: Pose) -> Velocity:
+        return self.action
+
+
+def random_agent(
+    model: str, grid, body: Body, rng: np.random.Generator
+) -> Wanderer | RandomActions:
+    """The random behaviour ``model`` (one of :data:`MODELS`) for one agent."""
+    return Wanderer(grid, body, rng) if model == "waypoint" else RandomActions(body, rng)

@@ -10,7 +10,14 @@ import pytest
 from pegame.api import Context
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from pegame.navigation import inflate
-from pegame.sims.grid import GridSimulator, _sweep, _sweep_reference, saturate, unicycle
+from pegame.sims.grid import (
+    GridSimulator,
+    _sweep,
+    _sweep_reference,
+    accelerate,
+    saturate,
+    unicycle,
+)
 from pegame.types import Body, Camera, Pose, Velocity
 
 PURSUER = Body(radius=0.2, v_max=0.5, w_max=1.8)
@@ -110,3 +117,46 @@ def test_start_inside_an_obstacle_is_refused():
     sim = simulator(room())
     with pytest.raises(ValueError, match="inside an obstacle"):
         sim.reset(Pose(0.1, 1.0), Pose(3.5, 2.5))
+
+
+def test_infinite_acceleration_takes_the_command_exactly():
+    """Not current + (command - current), which can differ in the last ulp: infinite
+    limits (the default) must give today's games bit for bit."""
+    current, cmd = Velocity(0.1, -0.7), Velocity(0.3, 0.2)
+    assert (0.1 + (0.3 - 0.1), -0.7 + (0.2 + 0.7)) != (0.3, 0.2)  # why it matters
+    assert accelerate(current, cmd, PURSUER, DT) == cmd
+
+
+def test_finite_acceleration_ramps_towards_the_command():
+    body = Body(0.2, 0.5, 1.8, a_max=1.0, alpha_max=2.0)
+    ramped = accelerate(Velocity(0.1, 0.5), Velocity(0.5, -1.8), body, DT)
+    assert ramped == Velocity(pytest.approx(0.2), pytest.approx(0.3))
+    assert accelerate(Velocity(0.1, 0.5), Velocity(0.15, 0.45), body, DT) == Velocity(0.15, 0.45)
+
+
+def test_a_wall_stops_the_forward_speed_and_keeps_the_turn_rate():
+    body = Body(0.2, 0.5, 1.8, a_max=1.0, alpha_max=2.0)
+    context = Context(room(), body, EVADER, Camera(), DT, 1.0)
+    sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
+    sim.reset(Pose(1.0, 1.5, 0.0), Pose(3.5, 2.5))  # heading at the pillar's left face
+    for _ in range(40):
+        sim.step(Velocity(0.5, 0.0), Velocity(), DT)
+    assert sim._pursuer.velocity == Velocity(0.0, 0.0)
+    at_wall = sim.poses[0]
+    sim.step(Velocity(0.5, 1.0), Velocity(), DT)  # still pressed against the wall, turning
+    assert sim._pursuer.velocity == Velocity(0.0, pytest.approx(0.2))
+    assert sim.poses[0].theta == pytest.approx(at_wall.theta + 0.2 * DT)
+
+
+def test_step_one_moves_one_agent_and_pauses_the_other():
+    body = Body(0.2, 0.5, 1.8, a_max=1.0, alpha_max=2.0)
+    context = Context(room(), body, body, Camera(), DT, 1.0)
+    sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
+    sim.reset(Pose(1.0, 1.0, 0.0), Pose(3.0, 2.5, 0.0))
+    sim.step(Velocity(0.5, 0.0), Velocity(0.5, 0.0), DT)
+    pursuer, evader, paused = *sim.poses, sim._evader.velocity
+    sim.step_one("pursuer", Velocity(0.5, 0.0), DT)
+    assert sim.poses[1] == evader and sim._evader.velocity == paused
+    assert sim.poses[0].x > pursuer.x
+    sim.step_one("evader", Velocity(0.5, 0.0), DT)
+    assert sim.poses[1].x == pytest.approx(evader.x + 0.2 * DT)  # resumed from its kept 0.1 m/s

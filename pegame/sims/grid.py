@@ -1,7 +1,9 @@
 """The built-in 2D simulator: two unicycles on the occupancy grid.
 
-State x = (x, y, theta) in the map frame; a command (v, w) is saturated to the agent's
-limits and integrated exactly over dt (arc motion). An agent never enters a cell of the
+State x = (x, y, theta) in the map frame and the current velocity (v, w); a command (v, w)
+is saturated to the agent's limits, its change from the current velocity is limited to
+``a_max * dt`` and ``alpha_max * dt`` (each step; infinite limits, the default, take the
+command at once) and the result is integrated exactly over dt (arc motion). An agent never enters a cell of the
 grid inflated by its radius (:func:`pegame.navigation.inflate`): a move that would enter
 one is cut at the last free sample, so the agent stops at the wall and may still turn.
 The agents do not collide with each other (the paper's agents never need to touch).
@@ -20,12 +22,28 @@ from numba import njit
 from pegame.api import Simulator
 from pegame.grid import cell_blocked, point_cell
 from pegame.navigation import shared_inflation
-from pegame.types import Body, Pose, SensorFrame, Velocity, wrap_angle
+from pegame.types import STOP, Body, Pose, SensorFrame, Velocity, wrap_angle
 
 
 def saturate(cmd: Velocity, body: Body) -> Velocity:
     """Clip a command to |v| <= v_max (m/s) and |w| <= w_max (rad/s)."""
     return Velocity(_clip(cmd.v, body.v_max), _clip(cmd.w, body.w_max))
+
+
+def accelerate(current: Velocity, cmd: Velocity, body: Body, dt: float) -> Velocity:
+    """The velocity reached after dt seconds of driving from ``current`` towards the
+    (saturated) ``cmd`` at most ``body.a_max`` (m/s^2) and ``body.alpha_max`` (rad/s^2);
+    ``cmd`` itself, untouched, for infinite limits."""
+    return Velocity(
+        _ramp(current.v, cmd.v, body.a_max * dt), _ramp(current.w, cmd.w, body.alpha_max * dt)
+    )
+
+
+def _ramp(current: float, target: float, limit: float) -> float:
+    """``target``, or ``current`` moved towards it by at most ``limit``."""
+    if math.isinf(limit):
+        return target  # no limit: exactly today's command, not current + (target - current)
+    return current + _clip(target - current, limit)
 
 
 def _clip(value: float, limit: float) -> float:
@@ -83,17 +101,22 @@ class _Agent:
         self.blocked = shared_inflation(grid, body.radius)
         self.frame = grid.frame
         self.pose = Pose(0.0, 0.0, 0.0)
+        self.velocity = STOP
 
     def collides(self, x: float, y: float) -> bool:
         return cell_blocked(self.blocked, *point_cell(x, y, self.frame))
 
     def move(self, cmd: Velocity, dt: float) -> None:
         start = self.pose
-        target = unicycle(start, saturate(cmd, self.body), dt)
+        velocity = accelerate(self.velocity, saturate(cmd, self.body), self.body, dt)
+        target = unicycle(start, velocity, dt)
         # Sample the chord at half-cell spacing so that no move skips over a thin wall.
         n = max(1, math.ceil(2 * start.distance_to(target) / self.grid.resolution))
         x, y = _sweep(self.blocked, start.x, start.y, target.x, target.y, n, self.frame)
         self.pose = Pose(x, y, target.theta)
+        # An agent stopped by a wall has lost its forward speed; it keeps its turn rate.
+        blocked = math.hypot(target.x - x, target.y - y) > 1e-9
+        self.velocity = Velocity(0.0, velocity.w) if blocked else velocity
 
 
 class GridSimulator(Simulator):
@@ -117,11 +140,14 @@ class GridSimulator(Simulator):
                 raise ValueError(
                     f"start pose {pose} is inside an obstacle for radius {agent.body.radius} m"
                 )
-            agent.pose = pose
+            agent.pose, agent.velocity = pose, STOP
 
     def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
         self._pursuer.move(pursuer_cmd, dt)
         self._evader.move(evader_cmd, dt)
+
+    def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
+        (self._pursuer if role == "pursuer" else self._evader).move(cmd, dt)
 
     @property
     def poses(self) -> tuple[Pose, Pose]:

@@ -176,6 +176,13 @@ class PybulletSimulator(Simulator):
                     f"Invalid value for 'sim.collision_inset': {config.collision_inset!r}. Allowed: fewer "
                     f"cells than the {role} radius ({body.radius} m) at {context.grid.resolution} m per cell."
                 )
+            for key in ("a_max", "alpha_max"):
+                if math.isfinite(getattr(body, key)):
+                    raise ConfigError(
+                        f"Invalid value for '{role}.{key}': {getattr(body, key)!r}. The pybullet "
+                        f"simulator has no acceleration limits: leave {role}.{key} at .inf, or "
+                        "use the grid simulator (sim=grid)."
+                    )
         self._inset = inset
         self._client: Client | None = None
         self._frame: SensorFrame | None = None
