@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from omegaconf import OmegaConf
 
-from pegame.api import Context, PursuerObservation
+from pegame.api import Context, Pursuer, PursuerObservation
 from pegame.errors import ConfigError
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 from pegame.navigation import inflate
@@ -280,7 +280,7 @@ def test_config_file_matches_the_defaults():
     )
     assert node.pop("name") == "smart"
     defaults = SmartPursuer.Config()
-    own = {f.name for f in fields(defaults)} - {"radius", "w_max"}
+    own = {f.name for f in fields(defaults)} - {f.name for f in fields(Pursuer.Config)}
     assert set(node) == own
     assert all(node[key] == getattr(defaults, key) for key in own)
 
