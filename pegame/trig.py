@@ -64,7 +64,7 @@ EXP_NORMAL_MIN = -708.0
 EXP_MAX = 709.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")  # no zero-division branch (2 - c > 0): vectorised
 def exps(x):
     """exp of every element of the float array ``x`` (fdlibm's algorithm, < 1 ulp), each
     at most EXP_MAX; 0 where it is below EXP_NORMAL_MIN (also -inf), where the exact value

@@ -24,8 +24,9 @@ def wrap_angle(angle: float) -> float:
 
 
 def clamp(value: float, limit: float) -> float:
-    """``value`` limited to [-limit, limit] (limit >= 0)."""
-    return max(-limit, min(limit, value))
+    """``value`` limited to [-limit, limit] (limit >= 0), as a float; like np.clip, NaN
+    stays NaN."""
+    return float(min(max(value, -limit), limit))
 
 
 @dataclass(frozen=True)

@@ -210,6 +210,13 @@ class Perception:
         self.range = detection_range(config, context.camera)
         self.rngs = dict(zip(PARTS, rng.spawn(len(PARTS))))
         self.period = context.control_dt if config.rate is None else 1.0 / config.rate
+        # Every pipeline part off: each tick delivers its own capture, nothing to hold.
+        self.passthrough = (
+            config.rate is None
+            and config.latency == 0
+            and config.burst_miss_fraction == 0
+            and config.false_positive_rate == 0
+        )
         self.reset()
 
     def reset(self) -> None:
@@ -236,6 +243,8 @@ class Perception:
         s later; until then the previous result is held. ``camera_height`` (m) overrides
         the one given at construction for this frame's false positive (a rendering
         simulator's calibration knows it)."""
+        if self.passthrough:
+            return capture()
         if self._first_capture is None:
             self._first_capture = time
         # Without a rate every tick captures; with one, frames are due at whole periods

@@ -103,7 +103,7 @@ def _fill_noise(rng, unit_speeds, normals):
         normals[i] = rng.standard_normal()
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")  # res > 0: no zero-division branch
 def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, frame, blocked):
     """The particles (N, 3) moved by the unicycle model and the flat cell index (N,) each
     lands in (-1 in a blocked cell or off the grid).
@@ -148,7 +148,7 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
     return moved, cells
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")  # two_sigma2 > 0: no zero-division branch
 def _likelihoods(moved, zx, zy, two_sigma2):
     """exp(-|p_i - z|^2 / (2 sigma^2)) per particle (N,): the Gaussian likelihood of a
     detection at (zx, zy) (map frame, m), 0 where it would be below the smallest normal
@@ -160,7 +160,7 @@ def _likelihoods(moved, zx, zy, two_sigma2):
     return exps(exponents)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")  # divides by total > 0 only: no branch
 def _weigh(prior, cells, in_region, likelihood, detected, in_region_boost, miss_factor):
     """Measurement update of the weights (module docstring): (weights (N,), total,
     evidence, n_eff).

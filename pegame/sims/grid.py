@@ -22,12 +22,12 @@ from numba import njit
 from pegame.api import Simulator
 from pegame.grid import cell_blocked, point_cell
 from pegame.navigation import shared_inflation
-from pegame.types import STOP, Body, Pose, SensorFrame, Velocity, wrap_angle
+from pegame.types import STOP, Body, Pose, SensorFrame, Velocity, clamp, wrap_angle
 
 
 def saturate(cmd: Velocity, body: Body) -> Velocity:
     """Clip a command to |v| <= v_max (m/s) and |w| <= w_max (rad/s)."""
-    return Velocity(_clip(cmd.v, body.v_max), _clip(cmd.w, body.w_max))
+    return Velocity(clamp(cmd.v, body.v_max), clamp(cmd.w, body.w_max))
 
 
 def accelerate(current: Velocity, cmd: Velocity, body: Body, dt: float) -> Velocity:
@@ -43,12 +43,7 @@ def _ramp(current: float, target: float, limit: float) -> float:
     """``target``, or ``current`` moved towards it by at most ``limit``."""
     if math.isinf(limit):
         return target  # no limit: exactly today's command, not current + (target - current)
-    return current + _clip(target - current, limit)
-
-
-def _clip(value: float, limit: float) -> float:
-    """``value`` clipped to [-limit, limit]; like np.clip, NaN stays NaN."""
-    return float(min(max(value, -limit), limit))
+    return current + clamp(target - current, limit)
 
 
 def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
@@ -102,21 +97,26 @@ class _Agent:
         self.frame = grid.frame
         self.pose = Pose(0.0, 0.0, 0.0)
         self.velocity = STOP
+        # Without acceleration limits the command is the velocity: no state to keep.
+        self.limited = not (math.isinf(body.a_max) and math.isinf(body.alpha_max))
 
     def collides(self, x: float, y: float) -> bool:
         return cell_blocked(self.blocked, *point_cell(x, y, self.frame))
 
     def move(self, cmd: Velocity, dt: float) -> None:
         start = self.pose
-        velocity = accelerate(self.velocity, saturate(cmd, self.body), self.body, dt)
+        velocity = saturate(cmd, self.body)
+        if self.limited:
+            velocity = accelerate(self.velocity, velocity, self.body, dt)
         target = unicycle(start, velocity, dt)
         # Sample the chord at half-cell spacing so that no move skips over a thin wall.
         n = max(1, math.ceil(2 * start.distance_to(target) / self.grid.resolution))
         x, y = _sweep(self.blocked, start.x, start.y, target.x, target.y, n, self.frame)
         self.pose = Pose(x, y, target.theta)
-        # An agent stopped by a wall has lost its forward speed; it keeps its turn rate.
-        blocked = math.hypot(target.x - x, target.y - y) > 1e-9
-        self.velocity = Velocity(0.0, velocity.w) if blocked else velocity
+        if self.limited:
+            # An agent stopped by a wall has lost its forward speed; it keeps its turn rate.
+            blocked = math.hypot(target.x - x, target.y - y) > 1e-9
+            self.velocity = Velocity(0.0, velocity.w) if blocked else velocity
 
 
 class GridSimulator(Simulator):
