@@ -66,6 +66,7 @@ from scipy.ndimage import distance_transform_edt
 from pegame.api import Estimator
 from pegame.errors import MapError, require
 from pegame.estimators.resampling import RESAMPLERS, ThresholdResampler, effective_sample_size
+from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.trig import (
     MAX_ANGLE,
     exps,
@@ -127,8 +128,8 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
     for i in range(n):  # its own pass: the branches slow the passes above 2.5x
         moved[i, 2] = wrap_angle_kernel(moved[i, 2])
     cells = np.empty(n, dtype=np.int64)
-    ox, oy, res, rotate = frame.ox, frame.oy, frame.resolution, frame.rotated
-    c, s = frame.cos_yaw, frame.sin_yaw
+    ox, oy, res, rotate = frame[OX], frame[OY], frame[RESOLUTION], frame[ROTATED]
+    c, s = frame[COS_YAW], frame[SIN_YAW]
     height, width = blocked.shape
     for i in range(n):
         if not abs(heading[i]) <= MAX_ANGLE:
@@ -343,7 +344,7 @@ class ParticleFilter(Estimator):
             self.context.evader.v_max,
             cfg.turn_rate_std,
             dt,
-            self.context.grid.frame,
+            self.context.grid.kernel_frame,
             self.context.grid.blocked,
         )
         in_region = visible.holds(cells)  # V only where the particles are (module docstring)

@@ -13,16 +13,18 @@ import math
 
 from numba import njit
 
+from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
+
 
 @njit(cache=True, inline="always")
 def point_cell(x, y, frame):
     """(row, col) of the cell containing map point (x, y) (m); may lie off the grid."""
-    dx = x - frame.ox
-    dy = y - frame.oy
-    if frame.rotated:
-        c, s = frame.cos_yaw, frame.sin_yaw
+    dx = x - frame[OX]
+    dy = y - frame[OY]
+    if frame[ROTATED]:
+        c, s = frame[COS_YAW], frame[SIN_YAW]
         dx, dy = c * dx + s * dy, -s * dx + c * dy
-    return math.floor(dy / frame.resolution), math.floor(dx / frame.resolution)
+    return math.floor(dy / frame[RESOLUTION]), math.floor(dx / frame[RESOLUTION])
 
 
 @njit(cache=True, inline="always")

@@ -88,7 +88,7 @@ class SmartPursuer(Pursuer):
         self.planner = Planner.shared(context.grid, context.pursuer.radius)
         self.follower = PathFollower(context.pursuer)
         self.blocked = shared_inflation(context.grid, context.pursuer.radius)
-        self._frame = context.grid.frame
+        self._frame = context.grid.kernel_frame
         self.reset(Pose(0.0, 0.0))
 
     def reset(self, pose: Pose) -> None:

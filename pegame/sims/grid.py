@@ -94,7 +94,7 @@ class _Agent:
         self.grid = grid
         self.body = body
         self.blocked = shared_inflation(grid, body.radius)
-        self.frame = grid.frame
+        self.frame = grid.kernel_frame
         self.pose = Pose(0.0, 0.0, 0.0)
         self.velocity = STOP
         # Without acceleration limits the command is the velocity: no state to keep.

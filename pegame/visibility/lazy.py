@@ -21,6 +21,7 @@ import numpy as np
 from numba import njit
 
 from pegame.grid import OccupancyGrid
+from pegame.grid.occupancy import OX, OY, RESOLUTION
 from pegame.trig import wrap_angle_kernel
 from pegame.types import Camera, Pose
 from pegame.visibility.rays import directions, ray_tables
@@ -89,7 +90,7 @@ class VisibilityRegion:
         angles, distances, first = ray_tables(camera)
         return (
             grid.blocked,
-            grid.frame,
+            grid.kernel_frame,
             float(grid.origin[2]),
             float(pose.x),
             float(pose.y),
@@ -125,7 +126,7 @@ def _mask_over(
     col1,
 ):
     """Kernel of :meth:`VisibilityRegion.mask_over`: march the rays reaching the block."""
-    ox, oy, resolution = frame.ox, frame.oy, frame.resolution
+    ox, oy, resolution = frame[OX], frame[OY], frame[RESOLUTION]
     i0, i1, samples = _rays_reaching(
         angles,
         angle_step,
@@ -168,7 +169,7 @@ def _holds(
     far,
 ):
     """Kernel of :meth:`VisibilityRegion.holds` for a region not yet computed whole."""
-    ox, oy, resolution = frame.ox, frame.oy, frame.resolution
+    ox, oy, resolution = frame[OX], frame[OY], frame[RESOLUTION]
     near, (r0, r1, c0, c1) = _near_wedge(
         cells, blocked.shape[1], px, py, theta, ox, oy, yaw, resolution, fov, far
     )

@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from pegame.grid import per_grid, read_only
+from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, SIN_YAW
 from pegame.navigation.inflation import shared_obstacle_distance
 from pegame.types import Camera
 
@@ -80,7 +81,7 @@ def outlines_reference(runs, frame, rays, xs, ys, thetas, z, jump=False):
     height, width = runs.shape
     n, m = rays.ray_cos.size, rays.arc_cos.size
     out = np.empty((xs.size, n + m + 1, 3), dtype=np.float32)
-    c, s, resolution = frame.cos_yaw, frame.sin_yaw, frame.resolution
+    c, s, resolution = frame[COS_YAW], frame[SIN_YAW], frame[RESOLUTION]
     near = rays.near
     # Cells that straddle the near range are only partly seen: reach starts one cell beyond it.
     start = near / resolution + 1.0
@@ -90,8 +91,8 @@ def outlines_reference(runs, frame, rays, xs, ys, thetas, z, jump=False):
     last = np.empty(n, dtype=np.int64)  # the last free sample of each ray
     for p in range(xs.size):
         x, y, theta = xs[p], ys[p], thetas[p]
-        u = (c * (x - frame.ox) + s * (y - frame.oy)) / resolution
-        v = (-s * (x - frame.ox) + c * (y - frame.oy)) / resolution
+        u = (c * (x - frame[OX]) + s * (y - frame[OY])) / resolution
+        v = (-s * (x - frame[OX]) + c * (y - frame[OY])) / resolution
         cm, sm = math.cos(theta), math.sin(theta)  # the heading in the map frame
         cg, sg = c * cm + s * sm, c * sm - s * cm  # the heading in the grid frame
         for i in range(n):
@@ -144,7 +145,14 @@ def visibility_outlines(
     march = _outlines_kernel if compiled else outlines_reference
     xs, ys, thetas = (np.asarray(v, dtype=float).reshape(-1) for v in (xs, ys, thetas))
     return march(
-        free_runs(grid), grid.frame, outline_rays(camera, rays), xs, ys, thetas, float(z), compiled
+        free_runs(grid),
+        grid.kernel_frame,
+        outline_rays(camera, rays),
+        xs,
+        ys,
+        thetas,
+        float(z),
+        compiled,
     )
 
 

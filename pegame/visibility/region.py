@@ -30,6 +30,7 @@ import numpy as np
 from numba import njit
 
 from pegame.grid import OccupancyGrid
+from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.types import Camera, Pose
 from pegame.visibility.rays import ray_directions, ray_tables
 
@@ -74,8 +75,8 @@ def _ray_cells(px, py, ray, distances, frame, shape, divide, cells):
     the function returns False when any sample came within _EDGE cells of a cell edge (the
     caller then redoes the ray with ``divide``) and True otherwise.
     """
-    ox, oy, res, rotate = frame.ox, frame.oy, frame.resolution, frame.rotated
-    c, s = frame.cos_yaw, frame.sin_yaw
+    ox, oy, res, rotate = frame[OX], frame[OY], frame[RESOLUTION], frame[ROTATED]
+    c, s = frame[COS_YAW], frame[SIN_YAW]
     cos_i, sin_i = ray
     height, width = shape
     inv = 1.0 / res
@@ -158,7 +159,7 @@ def whole_region(grid: OccupancyGrid, pose: Pose, camera: Camera):
     cos_a, sin_a = ray_directions(pose, camera)
     mask = np.zeros(grid.blocked.shape, dtype=bool)
     px, py = float(pose.x), float(pose.y)
-    bounds = march(grid.blocked, cos_a, sin_a, distances, first, px, py, grid.frame, mask)
+    bounds = march(grid.blocked, cos_a, sin_a, distances, first, px, py, grid.kernel_frame, mask)
     return mask, bounds
 
 

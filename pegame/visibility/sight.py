@@ -64,7 +64,7 @@ def line_of_sight(grid: OccupancyGrid, a_xy, b_xy, step: float | None = None) ->
         raise ValueError(f"step must be positive, got {step}")
     ax, ay = float(a_xy[0]), float(a_xy[1])
     bx, by = float(b_xy[0]), float(b_xy[1])
-    return _segment_clear(grid.blocked, ax, ay, bx, by, step, grid.frame)
+    return _segment_clear(grid.blocked, ax, ay, bx, by, step, grid.kernel_frame)
 
 
 def in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, point_xy) -> bool:
