@@ -212,6 +212,7 @@ def astar(
     goal,
     moves,
     landmark_costs,
+    tie_quantum,
     g,
     parent,
     keys,
@@ -225,7 +226,19 @@ def astar(
     The heuristic is the octile distance, admissible and consistent because every
     multiplier is >= 1, or the larger landmark bound when ``landmark_costs`` (K, n) has
     rows (see ``Planner._landmark_table``). Returns (inf, empty) when the goal is
-    unreachable. The other arrays (length n) are scratch: ``g`` must be all inf and
+    unreachable.
+
+    The heap orders cells by f = g + h, then by the smaller h. With ``tie_quantum`` q > 0
+    (m) f is first rounded down to a multiple of q: on an open grid every cell of the
+    parallelogram between start and goal lies on an optimal octile path, but their f
+    differ in the last bits (g sums the steps in different orders), so the exact key
+    never ties and A* expands most of the parallelogram (a 200 m search across a free
+    map visits millions of cells). Rounded keys tie, the smaller h goes first and the
+    search runs along one optimal path. A popped cell is then closed (never improved
+    again): with rounded keys a cell may be popped with a g larger than its least by
+    round-off, and reopening it would re-expand everything after it, again and again.
+    The cost found is optimal to within q per step of the path. q = 0 keeps the exact key
+    and no closed set (the paper maps' searches). The other arrays (length n) are scratch: ``g`` must be all inf and
     ``pos`` all -1 on entry, and both are restored before returning (only the ``touched``
     cells are reset, not the whole grid).
     """
@@ -238,13 +251,15 @@ def astar(
     parent[start] = -1
     h = _octile(resolution, start // padded_width, start % padded_width, goal_row, goal_col)
     h = _landmark_bound(landmark_costs, to_goal, start, h)
-    _sift_up(keys, ties, nodes, pos, 0, start, h, h)
+    _sift_up(keys, ties, nodes, pos, 0, start, _key(h, tie_quantum), h)
     size = 1
     while size > 0:
         u = _pop(keys, ties, nodes, pos, size)
         size -= 1
         if u == goal:
             break
+        if tie_quantum > 0.0:
+            pos[u] = CLOSED
         row, col = u // padded_width, u % padded_width
         moves_u = allowed[u]
         for k in range(8):
@@ -252,7 +267,7 @@ def astar(
                 continue
             v = u + offsets[k]
             candidate = g[u] + lengths[k] * (0.5 * (multipliers[u] + multipliers[v]))
-            if candidate < g[v]:
+            if candidate < g[v] and pos[v] != CLOSED:
                 if g[v] == np.inf:
                     touched[count] = v
                     count += 1
@@ -265,7 +280,7 @@ def astar(
                 slot = pos[v] if pos[v] >= 0 else size
                 if pos[v] < 0:
                     size += 1
-                _sift_up(keys, ties, nodes, pos, slot, v, candidate + h, h)
+                _sift_up(keys, ties, nodes, pos, slot, v, _key(candidate + h, tie_quantum), h)
     cost = g[goal]
     path = _trace(parent, start, goal) if np.isfinite(cost) else np.empty(0, dtype=np.int64)
     for i in range(count):
@@ -274,11 +289,25 @@ def astar(
     return cost, path
 
 
+#: ``pos`` of a cell A* has closed (with a tie quantum only)
+CLOSED = -2
+
+
+@njit(cache=True)
+def _key(f, tie_quantum):
+    """The heap key of f (m): f itself, or f rounded down to a multiple of ``tie_quantum``."""
+    if tie_quantum > 0.0:
+        return math.floor(f / tie_quantum) * tie_quantum
+    return f
+
+
 @njit(cache=True)
 def _landmark_bound(landmark_costs, to_goal, v, h):
-    """The largest of ``h`` and the landmark bounds |cost(L, goal) - cost(L, v)| (m)."""
+    """The largest of ``h`` and the landmark bounds |cost(L, goal) - cost(L, v)| (m),
+    subtracted in float64 (exactly, for float32 costs: the consistency argument of
+    ``Planner._landmark_table`` needs the difference unrounded)."""
     for k in range(to_goal.size):
-        h = max(h, abs(to_goal[k] - landmark_costs[k, v]))
+        h = max(h, abs(np.float64(to_goal[k]) - np.float64(landmark_costs[k, v])))
     return h
 
 
