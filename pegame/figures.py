@@ -15,6 +15,10 @@ from pegame.grid import OccupancyGrid
 
 PURSUER_COLOR = "#dc2828"
 EVADER_COLOR = "#1ea03c"
+#: most map cells drawn per side: a larger map is drawn by blocks of cells, each as dark
+#: as its darkest cell (the figure is about 840 px wide; matplotlib would otherwise
+#: convert every cell of a 4000 x 4000 map to RGBA floats, seconds and gigabytes)
+MAX_DRAWN_CELLS = 1000
 
 
 def map_shades(grid: OccupancyGrid) -> np.ndarray:
@@ -22,6 +26,21 @@ def map_shades(grid: OccupancyGrid) -> np.ndarray:
     unknown mid grey, and ``scale``-mode values in between."""
     occupancy = np.clip(grid.data.astype(float), 0.0, 100.0) / 100.0
     return np.where(grid.data < 0, 0.6, 1.0 - 0.75 * occupancy)
+
+
+def _drawn_shades(grid: OccupancyGrid) -> tuple[np.ndarray, int]:
+    """The map's shades as drawn and the edge (cells) of the square block each stands for:
+    :func:`map_shades` itself (block 1) up to MAX_DRAWN_CELLS cells a side, else the
+    darkest shade of each block, the last blocks padded with the edge cells' shades."""
+    shades = map_shades(grid)
+    block = -(-max(grid.height, grid.width) // MAX_DRAWN_CELLS)
+    if block == 1:
+        return shades, 1
+    rows, cols = -(-grid.height // block), -(-grid.width // block)
+    padded = np.pad(
+        shades, ((0, rows * block - grid.height), (0, cols * block - grid.width)), "edge"
+    )
+    return padded.reshape(rows, block, cols, block).min(axis=(1, 3)), block
 
 
 def plot_trajectory(
@@ -52,9 +71,13 @@ def plot_trajectory(
     FigureCanvasAgg(figure)
     axes = figure.add_subplot()
     ox, oy, yaw = grid.origin
-    width, height = grid.width * grid.resolution, grid.height * grid.resolution
+    shades, block = _drawn_shades(grid)
+    width, height = (
+        shades.shape[1] * block * grid.resolution,
+        shades.shape[0] * block * grid.resolution,
+    )
     image = axes.imshow(
-        map_shades(grid),
+        shades,
         cmap="gray",
         vmin=0.0,
         vmax=1.0,
