@@ -276,18 +276,20 @@ class Planner:
         return self._landmarks
 
     def _search_scratch(self) -> tuple[np.ndarray, ...]:
-        """A*'s scratch arrays (g, parent, keys, ties, nodes, pos, touched), g all inf and
-        pos all -1 between searches."""
+        """A*'s scratch arrays (g, parent, keys, ties, nodes, pos, touched, seen), seen all
+        False between searches. All are left uninitialised or zeroed by the system (see
+        search.astar), so a search uses the memory of the cells it reaches only."""
         if self._astar_scratch is None:
             n = self._allowed.size
             self._astar_scratch = (
-                np.full(n, np.inf),
+                np.empty(n),
                 np.empty(n, np.int32),
                 np.empty(n),
                 np.empty(n),
                 np.empty(n, np.int32),
-                np.full(n, -1, np.int32),
                 np.empty(n, np.int32),
+                np.empty(n, np.int32),
+                np.zeros(n, np.bool_),
             )
         return self._astar_scratch
 

@@ -220,6 +220,7 @@ def astar(
     nodes,
     pos,
     touched,
+    seen,
 ):
     """Minimum weighted cost (m) and flat cell path from ``start`` to ``goal`` by A*.
 
@@ -238,14 +239,21 @@ def astar(
     again): with rounded keys a cell may be popped with a g larger than its least by
     round-off, and reopening it would re-expand everything after it, again and again.
     The cost found is optimal to within q per step of the path. q = 0 keeps the exact key
-    and no closed set (the paper maps' searches). The other arrays (length n) are scratch: ``g`` must be all inf and
-    ``pos`` all -1 on entry, and both are restored before returning (only the ``touched``
-    cells are reset, not the whole grid).
+    and no closed set (the paper maps' searches).
+
+    The other arrays (length n) are scratch. ``seen`` (bool) must be all False on entry
+    and is restored before returning (only the ``touched`` cells are reset, not the whole
+    grid); the others are read only where ``seen`` is set (a cell's g, heap slot and
+    parent are written when the search first reaches it), so they may be allocated
+    uninitialised and only the memory pages of the cells a search reaches are ever
+    used: on a large map a short search costs little memory.
     """
     offsets, lengths = _move_tables(padded_width, moves, resolution)
     goal_row, goal_col = goal // padded_width, goal % padded_width
     to_goal = landmark_costs[:, goal].copy()
     g[start] = 0.0
+    pos[start] = -1
+    seen[start] = True
     touched[0] = start
     count = 1
     parent[start] = -1
@@ -267,10 +275,13 @@ def astar(
                 continue
             v = u + offsets[k]
             candidate = g[u] + lengths[k] * (0.5 * (multipliers[u] + multipliers[v]))
+            if not seen[v]:
+                seen[v] = True
+                touched[count] = v
+                count += 1
+                g[v] = np.inf
+                pos[v] = -1
             if candidate < g[v] and pos[v] != CLOSED:
-                if g[v] == np.inf:
-                    touched[count] = v
-                    count += 1
                 g[v] = candidate
                 parent[v] = u
                 h = _octile(resolution, row + moves[k, 0], col + moves[k, 1], goal_row, goal_col)
@@ -281,11 +292,10 @@ def astar(
                 if pos[v] < 0:
                     size += 1
                 _sift_up(keys, ties, nodes, pos, slot, v, _key(candidate + h, tie_quantum), h)
-    cost = g[goal]
+    cost = g[goal] if seen[goal] else np.inf
     path = _trace(parent, start, goal) if np.isfinite(cost) else np.empty(0, dtype=np.int64)
     for i in range(count):
-        g[touched[i]] = np.inf
-        pos[touched[i]] = -1
+        seen[touched[i]] = False
     return cost, path
 
 
