@@ -43,7 +43,8 @@ class PathResult:
     exact goal point when its cell is traversable; empty when unreachable. length: the
     polyline length of ``path`` (m). cost: the weighted grid cost of the cell path (m,
     see :class:`Planner`); inf when unreachable. reachable: whether a path was found.
-    reason: '' when reachable, else why not.
+    reason: '' when reachable, else why not. searched: how many cells the search reached
+    (its work and memory; 0 when no search ran).
     """
 
     path: np.ndarray
@@ -51,6 +52,7 @@ class PathResult:
     reachable: bool
     reason: str = ""
     cost: float = math.inf
+    searched: int = 0
 
 
 def _unreachable(reason: str) -> PathResult:
@@ -339,7 +341,7 @@ class Planner:
                 if not self.grid.contains(row, col):
                     return _unreachable("goal is outside the map")
                 return _unreachable("goal is inside an obstacle")
-        cost, cells = astar(
+        cost, cells, searched = astar(
             self._allowed,
             self._padded_multipliers,
             self.grid.resolution,
@@ -357,4 +359,4 @@ class Planner:
         if exact_goal:
             path = np.vstack([path, np.asarray(goal_xy, dtype=float).reshape(1, 2)])
         length = float(np.hypot(*np.diff(path, axis=0).T).sum())
-        return PathResult(path, length, True, "", float(cost))
+        return PathResult(path, length, True, "", float(cost), int(searched))

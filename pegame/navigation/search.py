@@ -222,11 +222,12 @@ def astar(
     touched,
     seen,
 ):
-    """Minimum weighted cost (m) and flat cell path from ``start`` to ``goal`` by A*.
+    """Minimum weighted cost (m), flat cell path and number of cells reached from
+    ``start`` to ``goal`` by A*.
 
     The heuristic is the octile distance, admissible and consistent because every
     multiplier is >= 1, or the larger landmark bound when ``landmark_costs`` (K, n) has
-    rows (see ``Planner._landmark_table``). Returns (inf, empty) when the goal is
+    rows (see ``Planner._landmark_table``). Returns (inf, empty, reached) when the goal is
     unreachable.
 
     The heap orders cells by f = g + h, then by the smaller h. With ``tie_quantum`` q > 0
@@ -296,7 +297,7 @@ def astar(
     path = _trace(parent, start, goal) if np.isfinite(cost) else np.empty(0, dtype=np.int64)
     for i in range(count):
         seen[touched[i]] = False
-    return cost, path
+    return cost, path, count
 
 
 #: ``pos`` of a cell A* has closed (with a tie quantum only)
