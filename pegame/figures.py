@@ -32,15 +32,21 @@ def _drawn_shades(grid: OccupancyGrid) -> tuple[np.ndarray, int]:
     """The map's shades as drawn and the edge (cells) of the square block each stands for:
     :func:`map_shades` itself (block 1) up to MAX_DRAWN_CELLS cells a side, else the
     darkest shade of each block, the last blocks padded with the edge cells' shades."""
-    shades = map_shades(grid)
     block = -(-max(grid.height, grid.width) // MAX_DRAWN_CELLS)
     if block == 1:
-        return shades, 1
+        return map_shades(grid), 1
+    # The blocks' minimum is taken over one byte per cell, the rank of the cell's value
+    # among the shades of all 256 values (a float shade per cell costs 8 bytes a pass).
+    values = np.arange(-128, 128, dtype=np.int8)
+    shade_of_value = map_shades(OccupancyGrid(values.reshape(1, -1), grid.resolution))[0]
+    order = np.argsort(shade_of_value, kind="stable")
+    rank = np.empty(256, dtype=np.uint8)
+    rank[order] = np.arange(256)
+    ranks = rank[grid.data.view(np.uint8) ^ 0x80]  # int8 value v -> index v + 128
     rows, cols = -(-grid.height // block), -(-grid.width // block)
-    padded = np.pad(
-        shades, ((0, rows * block - grid.height), (0, cols * block - grid.width)), "edge"
-    )
-    return padded.reshape(rows, block, cols, block).min(axis=(1, 3)), block
+    padding = ((0, rows * block - grid.height), (0, cols * block - grid.width))
+    darkest = np.pad(ranks, padding, "edge").reshape(rows, block, cols, block).min(axis=(1, 3))
+    return shade_of_value[order][darkest], block
 
 
 def plot_trajectory(
