@@ -21,6 +21,7 @@ from pegame.figures import MAX_DRAWN_CELLS, _drawn_shades, map_shades
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, load_map
 from pegame.grid.ros import _MapSpec, _occupancy
 from pegame.navigation import LARGE_GRID_CELLS, TIE_QUANTUM, Planner
+from pegame.navigation.inflation import obstacle_distance, obstacle_distance_reference
 from pegame.navigation.search import MOVES, SQRT2, astar_reference
 from pegame.types import Camera, Pose
 from pegame.visibility import visibility_region
@@ -214,3 +215,14 @@ def test_the_scaling_bench_measures_a_small_map(tmp_path):
     assert all(math.isfinite(v) and v > 0 for v in row.values())
     text = "\n".join(format_rows([{"cells": 400, **row}]))
     assert "400 x  400" in text and text.rstrip().endswith("-")  # no game measured
+
+
+@pytest.mark.parametrize("resolution", [0.05, 0.1, 0.037])
+def test_obstacle_distances_are_scipy_s_to_the_last_bit(resolution):
+    for seed in range(3):
+        grid = pillared_grid(seed, size=70, resolution=resolution)
+        fast, reference = obstacle_distance(grid), obstacle_distance_reference(grid)
+        assert fast.dtype == reference.dtype == np.float64
+        np.testing.assert_array_equal(fast.view(np.int64), reference.view(np.int64))
+    paper = load_map(resolve_map_path("hall.yaml"))
+    np.testing.assert_array_equal(obstacle_distance(paper), obstacle_distance_reference(paper))
