@@ -22,7 +22,13 @@ from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, load_map
 from pegame.grid.ros import _MapSpec, _occupancy
 from pegame.navigation import LARGE_GRID_CELLS, TIE_QUANTUM, Planner
 from pegame.navigation.inflation import obstacle_distance, obstacle_distance_reference
-from pegame.navigation.search import MOVES, SQRT2, astar_reference
+from pegame.navigation.search import (
+    MOVES,
+    SQRT2,
+    _reference_neighbours,
+    allowed_moves,
+    astar_reference,
+)
 from pegame.types import Camera, Pose
 from pegame.visibility import visibility_region
 
@@ -226,3 +232,18 @@ def test_obstacle_distances_are_scipy_s_to_the_last_bit(resolution):
         np.testing.assert_array_equal(fast.view(np.int64), reference.view(np.int64))
     paper = load_map(resolve_map_path("hall.yaml"))
     np.testing.assert_array_equal(obstacle_distance(paper), obstacle_distance_reference(paper))
+
+
+def test_allowed_moves_are_the_reference_s_neighbours():
+    grid = pillared_grid(5, size=40)
+    planner = Planner(grid, 0.1)
+    allowed = allowed_moves(planner.traversable).reshape(grid.height + 2, grid.width + 2)
+    ones = np.ones(grid.data.shape)
+    for row, col in np.ndindex(grid.data.shape):
+        bits = allowed[row + 1, col + 1]
+        mine = {(row + dr, col + dc) for k, (dr, dc) in enumerate(MOVES.tolist()) if bits >> k & 1}
+        cell = (row, col)
+        reference = _reference_neighbours(planner.traversable, ones, False, 0.1, cell)
+        expected = {nxt for nxt, _ in reference} if planner.traversable[cell] else set()
+        assert mine == expected
+    assert not allowed[[0, -1], :].any() and not allowed[:, [0, -1]].any()

@@ -136,7 +136,7 @@ class Planner:
         self._any_traversable = bool(self.traversable.any())
         self._nearest: np.ndarray | None = None  # see _nearest_cells
         self._padded_width = grid.width + 2
-        self._allowed = allowed_moves(pad_flat(self.traversable, False), self._padded_width, MOVES)
+        self._allowed = allowed_moves(self.traversable)
         # Search scratch memory, allocated at the first search that needs it.
         self._astar_scratch: tuple[np.ndarray, ...] | None = None
         self._bucket_pool: tuple[np.ndarray, np.ndarray] | None = None

@@ -48,26 +48,25 @@ def _move_tables(padded_width, moves, resolution):
     return offsets, lengths
 
 
-@njit(cache=True)
-def allowed_moves(traversable, padded_width, moves):
-    """Uint8 per flat padded cell: bit k set when move k is allowed from the cell, i.e. the
-    cell and its target are traversable and, for a diagonal move, so are the two cells it
-    passes between."""
-    allowed = np.zeros(traversable.size, dtype=np.uint8)
-    offsets = moves[:, 0] * padded_width + moves[:, 1]
-    for u in range(padded_width, traversable.size - padded_width):
-        if not traversable[u]:
-            continue
-        for k in range(8):
-            if not traversable[u + offsets[k]]:
-                continue
-            if moves[k, 0] != 0 and moves[k, 1] != 0:
-                if not (
-                    traversable[u + moves[k, 0] * padded_width] and traversable[u + moves[k, 1]]
-                ):
-                    continue
-            allowed[u] |= 1 << k
-    return allowed
+def allowed_moves(traversable: np.ndarray) -> np.ndarray:
+    """Uint8 per flat padded cell of the bool (H, W) ``traversable``: bit k set when move
+    k of MOVES is allowed from the cell, i.e. the cell and its target are traversable
+    and, for a diagonal move, so are the two cells it passes between. One vectorised
+    pass per move over the whole grid (the padding ring allows no move)."""
+    height, width = traversable.shape
+    padded = np.pad(traversable, 1, constant_values=False)
+    allowed = np.zeros(padded.shape, dtype=np.uint8)
+
+    def shifted(dr: int, dc: int) -> np.ndarray:
+        return padded[1 + dr : height + 1 + dr, 1 + dc : width + 1 + dc]
+
+    for k, (dr, dc) in enumerate(MOVES.tolist()):
+        ok = traversable & shifted(dr, dc)
+        if dr and dc:
+            ok &= shifted(dr, 0)
+            ok &= shifted(0, dc)
+        allowed[1:-1, 1:-1] |= ok.view(np.uint8) << k
+    return allowed.ravel()
 
 
 @njit(cache=True)
