@@ -21,7 +21,8 @@ Per size, each in a fresh process so that its peak memory is its own:
   (escape point and path): medians (ms) over game-like starts (:func:`pegame.game.spawn`:
   the evader in the pursuer's view), after setup;
 - ``peak_mb``: that process's peak resident memory (MB), Python and numba included;
-- ``game_s`` and ``game_peak_mb``: wall time (s) and peak memory (MB) of
+- ``game_s``, ``game_cpu_s`` and ``game_peak_mb``: wall time (s), CPU time (s, user +
+  system: on a shared machine the wall time also counts other work) and peak memory (MB) of
   ``python -m pegame pursuer=smart evader=smart env.map=... game.t_max=10 recorder=none``
   from launch to exit (numba's on-disk cache warm), as a user runs it.
 """
@@ -152,8 +153,8 @@ def measure_parts(yaml_path: str, repeat: int) -> dict[str, float]:
     }
 
 
-def measure_game(yaml_path: str, out_dir: str) -> tuple[float, float]:
-    """(wall s, peak MB) of a GAME_SECONDS S-S game played by ``python -m pegame`` on the
+def measure_game(yaml_path: str, out_dir: str) -> tuple[float, float, float]:
+    """(wall s, CPU s, peak MB) of a GAME_SECONDS S-S game played by ``python -m pegame`` on the
     map at ``yaml_path``, from launch to exit. Raises RuntimeError if the game fails."""
     command = [
         sys.executable,
@@ -176,7 +177,7 @@ def measure_game(yaml_path: str, out_dir: str) -> tuple[float, float]:
             log.seek(0)
             error = log.read().decode(errors="replace")
             raise RuntimeError(f"{' '.join(command)} failed:\n{error[-2000:]}")
-    return wall, usage.ru_maxrss / 1024
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
 
 
 def map_scaling(
@@ -192,7 +193,8 @@ def map_scaling(
             with context.Pool(1) as pool:
                 row: dict[str, Any] = {"cells": cells, **pool.apply(measure_parts, (path, repeat))}
             if game:
-                row["game_s"], row["game_peak_mb"] = measure_game(path, f"{tmp}/game_{cells}")
+                game_s, cpu_s, peak_mb = measure_game(path, f"{tmp}/game_{cells}")
+                row.update(game_s=game_s, game_cpu_s=cpu_s, game_peak_mb=peak_mb)
             rows.append(row)
     return rows
 
@@ -206,13 +208,14 @@ def format_rows(rows: list[dict[str, Any]]) -> list[str]:
     lines = [
         "map size against cost (a paper map scaled up, 0.05 m cells, each size in new processes):",
         f"{'cells':>11}{'setup s':>9}{'P dec ms':>10}{'E dec ms':>10}{'peak MB':>9}"
-        f"{f'{GAME_SECONDS:.0f} s S-S game s':>19}{'game MB':>9}",
+        f"{f'{GAME_SECONDS:.0f} s S-S game: wall s':>25}{'CPU s':>7}{'peak MB':>9}",
     ]
     for row in rows:
         lines.append(
             f"{row['cells']:>5} x{row['cells']:>5}{_fmt(row['setup_s']):>9}"
             f"{_fmt(row['pursuer_decision_ms']):>10}{_fmt(row['evader_decision_ms']):>10}"
-            f"{_fmt(row['peak_mb']):>9}{_fmt(row.get('game_s')):>19}{_fmt(row.get('game_peak_mb')):>9}"
+            f"{_fmt(row['peak_mb']):>9}{_fmt(row.get('game_s')):>25}"
+            f"{_fmt(row.get('game_cpu_s')):>7}{_fmt(row.get('game_peak_mb')):>9}"
         )
     return lines
 
