@@ -16,6 +16,7 @@ import pytest
 
 from pegame.bench_maps import format_rows, measure_parts, scaled_map, write_map
 from pegame.config import resolve_map_path
+from pegame.evaders import escape
 from pegame.evaders.escape import EscapeSearch
 from pegame.figures import MAX_DRAWN_CELLS, _drawn_shades, map_shades
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, load_map
@@ -247,3 +248,23 @@ def test_allowed_moves_are_the_reference_s_neighbours():
         expected = {nxt for nxt, _ in reference} if planner.traversable[cell] else set()
         assert mine == expected
     assert not allowed[[0, -1], :].any() and not allowed[:, [0, -1]].any()
+
+
+@pytest.mark.parametrize("distance", ["euclidean", "geodesic"])
+def test_escapes_sorting_only_the_lowest_bounds_first_match_the_reference(monkeypatch, distance):
+    """With few tiles sorted first, the search continues into the rest when it must, and
+    the escape is still the reference's to the last bit."""
+    monkeypatch.setattr(escape, "FIRST_TILES", 3)
+    for seed in range(6):
+        grid = pillared_grid(seed, size=90)
+        planner = Planner(grid, 0.12)
+        pursuer_planner = Planner(grid, 0.08) if distance == "geodesic" else None
+        search = EscapeSearch(grid, CAMERA, planner, pursuer_planner, distance, 1, 0.2)
+        rng = np.random.default_rng(seed)
+        rows, cols = np.nonzero(planner.traversable)
+        for _ in range(4):
+            i, j = rng.integers(rows.size, size=2)
+            pursuer = Pose(*grid.cell_to_world(rows[i], cols[i]), rng.uniform(-math.pi, math.pi))
+            me = Pose(*grid.cell_to_world(rows[j], cols[j]))
+            fast, slow = search.escape(me, pursuer), search.escape_reference(me, pursuer)
+            assert (fast.cell, fast.cost, fast.count) == (slow.cell, slow.cost, slow.count)
