@@ -20,7 +20,8 @@ Per size, each in a fresh process so that its peak memory is its own:
   lost, as :func:`pegame.bench.bench_decisions` times it) and ``evader_decision_ms``
   (escape point and path): medians (ms) over game-like starts (:func:`pegame.game.spawn`:
   the evader in the pursuer's view), after setup;
-- ``peak_mb``: that process's peak resident memory (MB), Python and numba included;
+- ``peak_mb``: that process's peak resident memory (MB), Python and numba included (and
+  what the launching program imports: a spawned worker imports its main module again);
 - ``game_s``, ``game_cpu_s`` and ``game_peak_mb``: wall time (s), CPU time (s, user +
   system: on a shared machine the wall time also counts other work) and peak memory (MB) of
   ``python -m pegame pursuer=smart evader=smart env.map=... game.t_max=10 recorder=none``
