@@ -27,6 +27,7 @@ import numpy as np
 
 from pegame import registry
 from pegame.api import Context, EvaderObservation, PursuerObservation
+from pegame.bench_maps import SIZES, format_rows, map_scaling
 from pegame.config import compose, resolve_map_path
 from pegame.game import Game
 from pegame.grid import OccupancyGrid, load_map
@@ -175,43 +176,6 @@ def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]
     return out
 
 
-def warehouse(height: int = 1000, width: int = 1667, resolution: float = 0.03) -> OccupancyGrid:
-    """A synthetic 30 m x 50 m warehouse at 3 cm/cell: outer walls and rows of shelving
-    (1 m deep, 8 m long) with 2.5 m aisles and cross-aisles."""
-    data = np.zeros((height, width), dtype=np.int8)
-    data[:10, :] = data[-10:, :] = data[:, :10] = data[:, -10:] = 100
-    shelf_h, shelf_w = int(1.0 / resolution), int(8.0 / resolution)
-    for row in range(int(3.0 / resolution), height - shelf_h - 60, int(3.5 / resolution)):
-        for col in range(int(3.0 / resolution), width - shelf_w - 60, int(11.0 / resolution)):
-            data[row : row + shelf_h, col : col + shelf_w] = 100
-    return OccupancyGrid(data, resolution, name="warehouse")
-
-
-def large_map_decision(repeat: int) -> tuple[float | None, float]:
-    """(ms per decision tick, process peak MB) on the warehouse: visibility region,
-    estimator update, smart evader and smart pursuer decisions. Run in a fresh process so
-    that the peak memory is this workload's alone."""
-    import multiprocessing
-
-    with multiprocessing.get_context("spawn").Pool(1) as pool:
-        return pool.apply(_large_map_worker, (repeat,))
-
-
-def _large_map_worker(repeat: int) -> tuple[float | None, float]:
-    grid = warehouse()
-    bench_decisions(grid, 1)  # builds the shared planners and their landmarks once
-    out = bench_decisions(grid, repeat)
-    parts = [out["pursuer_decision_ms"], out["evader_decision_ms"]]
-    if None in parts:
-        return None, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    camera = Camera()
-    poses = iter(free_poses(grid, 0.2, repeat + 1, seed=4) * 2)
-    vis_ms = median_ms(lambda: visibility_region(grid, next(poses), camera), repeat)
-    # A decision tick: the visibility region, the pursuer's (estimator update + plan, as
-    # bench_decisions times them together) and the evader's decision.
-    return vis_ms + sum(parts), resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
 def recorder_cost(games: int, out_dir: str) -> tuple[float | None, float | None]:
     """(fractional extra time of recording an S-S game with recorder=rerun, MB per .rrd).
 
@@ -274,6 +238,14 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--quick", action="store_true", help="fewer repetitions (under a minute)")
+    parser.add_argument(
+        "--map-sizes",
+        type=int,
+        nargs="+",
+        metavar="CELLS",
+        help=f"map sizes (cells a side) of the scaling table; default {' '.join(map(str, SIZES))}, "
+        "with --quick 400 1000 and no whole games",
+    )
     args = parser.parse_args(argv)
     repeat, games = (20, 2) if args.quick else (200, 5)
 
@@ -310,8 +282,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         report[key] = max(values) if values else None  # the worst paper map
     rates = [m["ss_games_per_s"] for m in per_map.values() if m.get("ss_games_per_s") is not None]
     report["ss_games_per_s"] = min(rates) if rates else None  # the slowest paper map
-    report["large_map_decision_ms"], report["large_map_peak_mb"] = large_map_decision(
-        max(5, repeat // 10)
+    quick_sizes = (400, 1000) if args.quick else SIZES
+    report["map_scaling"] = map_scaling(
+        args.map_sizes or quick_sizes, repeat=max(5, repeat // 10), game=not args.quick
     )
     report["env_steps_per_s"] = env_steps_per_second(2 if args.quick else 10)
     report.update(plugin_figures(args.quick))
@@ -361,10 +334,7 @@ def format_report(report: dict[str, Any]) -> str:
         f"pybullet S-S real-time factor: {fmt(report['pybullet_rtf'])}; vision vs segmentation: "
         f"precision {fmt(report['vision_precision'])}, recall {fmt(report['vision_recall'])}"
     )
-    lines.append(
-        f"warehouse 1000x1667 cells: {fmt(report['large_map_decision_ms'])} ms per decision tick, "
-        f"peak {fmt(report['large_map_peak_mb'])} MB"
-    )
+    lines.extend(format_rows(report["map_scaling"]))
     return "\n".join(lines)
 
 

@@ -15,6 +15,10 @@ from pegame.grid import OccupancyGrid
 
 PURSUER_COLOR = "#dc2828"
 EVADER_COLOR = "#1ea03c"
+#: most map cells drawn per side: a larger map is drawn by blocks of cells, each as dark
+#: as its darkest cell (the figure is about 840 px wide; matplotlib would otherwise
+#: convert every cell of a 4000 x 4000 map to RGBA floats, seconds and gigabytes)
+MAX_DRAWN_CELLS = 1000
 
 
 def map_shades(grid: OccupancyGrid) -> np.ndarray:
@@ -22,6 +26,27 @@ def map_shades(grid: OccupancyGrid) -> np.ndarray:
     unknown mid grey, and ``scale``-mode values in between."""
     occupancy = np.clip(grid.data.astype(float), 0.0, 100.0) / 100.0
     return np.where(grid.data < 0, 0.6, 1.0 - 0.75 * occupancy)
+
+
+def _drawn_shades(grid: OccupancyGrid) -> tuple[np.ndarray, int]:
+    """The map's shades as drawn and the edge (cells) of the square block each stands for:
+    :func:`map_shades` itself (block 1) up to MAX_DRAWN_CELLS cells a side, else the
+    darkest shade of each block, the last blocks padded with the edge cells' shades."""
+    block = -(-max(grid.height, grid.width) // MAX_DRAWN_CELLS)
+    if block == 1:
+        return map_shades(grid), 1
+    # The blocks' minimum is taken over one byte per cell, the rank of the cell's value
+    # among the shades of all 256 values (a float shade per cell costs 8 bytes a pass).
+    values = np.arange(-128, 128, dtype=np.int8)
+    shade_of_value = map_shades(OccupancyGrid(values.reshape(1, -1), grid.resolution))[0]
+    order = np.argsort(shade_of_value, kind="stable")
+    rank = np.empty(256, dtype=np.uint8)
+    rank[order] = np.arange(256)
+    ranks = rank[grid.data.view(np.uint8) ^ 0x80]  # int8 value v -> index v + 128
+    rows, cols = -(-grid.height // block), -(-grid.width // block)
+    padding = ((0, rows * block - grid.height), (0, cols * block - grid.width))
+    darkest = np.pad(ranks, padding, "edge").reshape(rows, block, cols, block).min(axis=(1, 3))
+    return shade_of_value[order][darkest], block
 
 
 def plot_trajectory(
@@ -52,9 +77,13 @@ def plot_trajectory(
     FigureCanvasAgg(figure)
     axes = figure.add_subplot()
     ox, oy, yaw = grid.origin
-    width, height = grid.width * grid.resolution, grid.height * grid.resolution
+    shades, block = _drawn_shades(grid)
+    width, height = (
+        shades.shape[1] * block * grid.resolution,
+        shades.shape[0] * block * grid.resolution,
+    )
     image = axes.imshow(
-        map_shades(grid),
+        shades,
         cmap="gray",
         vmin=0.0,
         vmax=1.0,

@@ -13,7 +13,7 @@ import pytest
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from pegame.navigation import (
     LARGE_GRID_CELLS,
-    LARGE_GRID_LANDMARKS,
+    TIE_QUANTUM,
     PathFollower,
     Planner,
     inflate,
@@ -148,10 +148,12 @@ def test_distance_field_matches_reference_and_bellman_ford(seed, weighted):
 
 
 @pytest.mark.parametrize("seed", SEEDS)
-@pytest.mark.parametrize("landmarks", [0, 3])
-def test_plans_are_clear_optimal_and_match_the_reference(seed, landmarks):
+@pytest.mark.parametrize(
+    ("landmarks", "tie_quantum"), [(0, 0.0), (3, 0.0), (0, TIE_QUANTUM), (3, TIE_QUANTUM)]
+)
+def test_plans_are_clear_optimal_and_match_the_reference(seed, landmarks, tie_quantum):
     grid = random_grid(seed)
-    planner = Planner(grid, 0.12, landmarks=landmarks)
+    planner = Planner(grid, 0.12, landmarks=landmarks, tie_quantum=tie_quantum)
     rng = np.random.default_rng(seed)
     starts, goals = random_points(rng, planner, 12), random_points(rng, planner, 12)
     for start, goal in zip(starts, goals):
@@ -274,11 +276,12 @@ def test_shared_planners_and_masks_are_built_once_per_grid_and_parameters():
     assert inflate(grid, 0.1).flags.writeable
 
 
-def test_landmarks_by_default_only_on_large_grids():
-    assert Planner(random_grid(0), 0.1).landmarks == 0  # the paper's maps keep the octile heuristic
+def test_keys_are_rounded_by_default_only_on_large_grids():
+    small = Planner(random_grid(0), 0.1)
+    assert small.tie_quantum == 0.0 and small.landmarks == 0  # the paper's maps: exact keys
     large = OccupancyGrid(np.zeros((1000, LARGE_GRID_CELLS // 1000), dtype=np.int8), 0.05)
-    assert Planner(large, 0.1).landmarks == LARGE_GRID_LANDMARKS
-    assert Planner(large, 0.1, landmarks=0).landmarks == 0
+    assert Planner(large, 0.1).tie_quantum == TIE_QUANTUM and Planner(large, 0.1).landmarks == 0
+    assert Planner(large, 0.1, tie_quantum=0.0).tie_quantum == 0.0
 
 
 def test_the_shared_cache_lives_and_dies_with_its_grid():

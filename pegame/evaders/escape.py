@@ -48,6 +48,7 @@ from numba import njit
 from scipy.ndimage import distance_transform_edt
 
 from pegame.grid import OccupancyGrid, per_grid
+from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.navigation import Planner
 from pegame.types import Camera, Pose
 from pegame.visibility import VisibilityRegion, visibility_region
@@ -59,6 +60,9 @@ DISTANCES = ("euclidean", "geodesic")
 MAX_RECORDED_CANDIDATES = 500
 #: edge (cells) of the square tiles that the fast argmin search scores or skips as a whole
 TILE = 8
+#: tiles sorted by bound before the search starts (see EscapeSearch.escape); more than
+#: the paper maps have (at most 1900), so theirs are all sorted at once as before
+FIRST_TILES = 4096
 #: a tile is skipped only when its cost bound exceeds the best cost by this relative
 #: amount: far more than the round-off of the bound and of the costs (~1e-15)
 BOUND_SLACK = 1e-9
@@ -174,37 +178,67 @@ def _tile_bounds(boxes, ex, ey, px, py):
     return bounds
 
 
+@njit(cache=True, inline="always")
+def _cell_centre(row, col, frame):
+    """Map-frame centre (x, y) (m) of cell (row, col), by the operations of
+    :meth:`pegame.grid.OccupancyGrid.cell_to_world` (so the same floats)."""
+    u = (float(col) + 0.5) * frame[RESOLUTION]
+    v = (float(row) + 0.5) * frame[RESOLUTION]
+    if frame[ROTATED]:
+        c, s = frame[COS_YAW], frame[SIN_YAW]
+        u, v = c * u - s * v, s * u + c * v
+    return u + frame[OX], v + frame[OY]
+
+
 @njit(cache=True)
 def _best_candidate(
-    tiles, bounds, starts, cells, rows, cols, xs, ys, exposed, top, left, agents, effort, dist
+    tiles,
+    bounds,
+    starts,
+    rows,
+    cols,
+    frame,
+    grid_width,
+    exposed,
+    top,
+    left,
+    agents,
+    effort,
+    dist,
+    best_cell,
+    best_cost,
 ):
-    """Algorithm 2's argmin over the unexposed cells: (flat cell, cost), (-1, inf) if none.
+    """Algorithm 2's argmin over the unexposed cells of ``tiles`` and the best (flat cell,
+    cost) found before them ((-1, inf) for none): (flat cell, cost, stopped), stopped
+    when a tile's bound ended the search before the last tile.
 
-    Cells come grouped by tile (tile t holds entries starts[t] to starts[t + 1]), with
-    their flat index, row, column and centre (m); ``tiles`` lists the tiles by
-    increasing bound. ``agents`` is (evader x, evader y, pursuer x, pursuer y) (m). With
-    flat distance fields ``effort`` and ``dist`` (m) the costs come from them, else from
-    Euclidean distances computed as :meth:`EscapeSearch.costs` does.
+    Cells come grouped by tile (tile t holds entries starts[t] to starts[t + 1]) as rows
+    and columns of the grid of ``grid_width`` columns and map-to-cell transform ``frame``
+    (``OccupancyGrid.kernel_frame``); ``tiles`` lists the tiles by increasing bound.
+    ``agents`` is (evader x, evader y, pursuer x, pursuer y) (m). With flat distance
+    fields ``effort`` and ``dist`` (m) the costs come from them, else from Euclidean
+    distances computed as :meth:`EscapeSearch.costs` does.
     """
     ex, ey, px, py = agents
     height, width = exposed.shape
-    best_cell, best_cost = -1, np.inf
     for t in tiles:
         if bounds[t] > best_cost * (1.0 + BOUND_SLACK):
-            break
+            return best_cell, best_cost, True
         for k in range(starts[t], starts[t + 1]):
             row, col = rows[k] - top, cols[k] - left
             if 0 <= row < height and 0 <= col < width and exposed[row, col]:
                 continue
+            cell = rows[k] * grid_width + cols[k]
             if effort.size:
-                e, d = effort[cells[k]], dist[cells[k]]
+                e, d = effort[cell], dist[cell]
             else:
-                ax, ay, bx, by = xs[k] - ex, ys[k] - ey, xs[k] - px, ys[k] - py
+                x, y = _cell_centre(rows[k], cols[k], frame)
+                ax, ay, bx, by = x - ex, y - ey, x - px, y - py
                 e, d = math.sqrt(ax * ax + ay * ay), math.sqrt(bx * bx + by * by)
             cost = e / d if d > 0.0 else np.inf
-            if cost < best_cost or (cost == best_cost and (best_cell < 0 or cells[k] < best_cell)):
-                best_cell, best_cost = cells[k], cost
-    return best_cell, best_cost
+            if cost < best_cost or (cost == best_cost and (best_cell < 0 or cell < best_cell)):
+                best_cell, best_cost = cell, cost
+    return best_cell, best_cost, False
 
 
 @njit(cache=True)
@@ -225,48 +259,82 @@ def _sample_positions(skipped, count, step):
 # ------------------------------------------------------------------ candidate cells
 
 
+@njit(cache=True)
+def _group_by_tile(candidate, frame):
+    """The cells of the bool (H, W) mask ``candidate``, row-major and grouped by tile.
+
+    Returns (cells, position, rows, cols, starts, boxes): the flat indices (K,) in
+    row-major order; per flat cell its index in ``cells``, -1 elsewhere; the rows and
+    columns (K,) grouped by TILE x TILE tile (tiles row-major, cells row-major within a
+    tile); where each non-empty tile's cells begin in them, (T + 1,); and each tile's
+    box (x min, x max, y min, y max) (m) of its cell centres, (T, 4), centres as
+    ``frame`` (``OccupancyGrid.kernel_frame``) places them. Int32 indices: this is the
+    largest per-map structure of the smart evader.
+    """
+    height, width = candidate.shape
+    count = 0
+    for row in range(height):
+        for col in range(width):
+            count += candidate[row, col]
+    cells = np.empty(count, dtype=np.int32)
+    position = np.full(height * width, -1, dtype=np.int32)
+    k = 0
+    for row in range(height):
+        for col in range(width):
+            if candidate[row, col]:
+                cells[k] = row * width + col
+                position[row * width + col] = k
+                k += 1
+    rows = np.empty(count, dtype=np.int32)
+    cols = np.empty(count, dtype=np.int32)
+    most = ((height + TILE - 1) // TILE) * ((width + TILE - 1) // TILE)
+    starts = np.empty(most + 1, dtype=np.int64)
+    boxes = np.empty((most, 4))
+    tiles, k = 0, 0
+    for top in range(0, height, TILE):
+        for left in range(0, width, TILE):
+            first = k
+            x0, x1, y0, y1 = np.inf, -np.inf, np.inf, -np.inf
+            for row in range(top, min(top + TILE, height)):
+                for col in range(left, min(left + TILE, width)):
+                    if candidate[row, col]:
+                        rows[k], cols[k] = row, col
+                        k += 1
+                        x, y = _cell_centre(row, col, frame)
+                        x0, x1, y0, y1 = min(x0, x), max(x1, x), min(y0, y), max(y1, y)
+            if k > first:
+                starts[tiles] = first
+                boxes[tiles, 0], boxes[tiles, 1] = x0, x1
+                boxes[tiles, 2], boxes[tiles, 3] = y0, y1
+                tiles += 1
+    starts[tiles] = count
+    return cells, position, rows, cols, starts[: tiles + 1].copy(), boxes[:tiles].copy()
+
+
 @dataclass(frozen=True, eq=False)
 class _Component:
     """The candidate cells (on the candidate stride) of one connected component.
 
-    mask: bool (H, W), the component. cells: flat indices (K,), row-major. position:
-    (H * W,) index of each flat cell in ``cells``, -1 elsewhere. by_tile: the cells
-    grouped by tile (row-major within a tile) as a dict of (K,) arrays "cells", "rows",
-    "cols", "xs", "ys" (centres, m). starts: (T + 1,) where each tile's cells begin in
-    by_tile. boxes: (T, 4) (x min, x max, y min, y max) (m) of each tile's centres.
+    mask: bool (H, W), the component. The rest as :func:`_group_by_tile` returns them:
+    cells, flat indices (K,), row-major; position, (H * W,) index of each flat cell in
+    ``cells``, -1 elsewhere; rows and cols (K,), the cells grouped by tile; starts, (T +
+    1,) where each tile's cells begin in rows and cols; boxes, (T, 4) (x min, x max, y
+    min, y max) (m) of each tile's centres.
     """
 
     mask: np.ndarray
     cells: np.ndarray
     position: np.ndarray
-    by_tile: dict
+    rows: np.ndarray
+    cols: np.ndarray
     starts: np.ndarray
     boxes: np.ndarray
 
     @classmethod
-    def build(cls, mask: np.ndarray, strided: np.ndarray, centres: np.ndarray) -> _Component:
+    def build(cls, mask: np.ndarray, strided: np.ndarray, frame: tuple) -> _Component:
         """The component ``mask`` (bool (H, W)) with its cells on the ``strided`` mask
-        (bool (H, W)); ``centres`` (H * W, 2) are the cell centres (m) by flat index."""
-        cells = np.flatnonzero(mask & strided)
-        position = np.full(mask.size, -1, dtype=np.int64)
-        position[cells] = np.arange(cells.size)
-        rows, cols = np.divmod(cells, mask.shape[1])
-        tiles = (rows // TILE) * (mask.shape[1] // TILE + 1) + cols // TILE
-        order = np.argsort(tiles, kind="stable")  # stable: row-major within a tile
-        grouped = cells[order]
-        xs, ys = centres[grouped, 0], centres[grouped, 1]
-        by_tile = {"cells": grouped, "rows": rows[order], "cols": cols[order], "xs": xs, "ys": ys}
-        starts = np.append(np.flatnonzero(np.diff(tiles[order], prepend=-1)), cells.size)
-        begin = starts[:-1]
-        boxes = np.column_stack(
-            [
-                np.minimum.reduceat(xs, begin),
-                np.maximum.reduceat(xs, begin),
-                np.minimum.reduceat(ys, begin),
-                np.maximum.reduceat(ys, begin),
-            ]
-        )
-        return cls(mask, cells, position, by_tile, starts, boxes)
+        (bool (H, W)) of a grid with map-to-cell transform ``frame``."""
+        return cls(mask, *_group_by_tile(mask & strided, frame))
 
 
 class EscapeSearch:
@@ -292,10 +360,8 @@ class EscapeSearch:
         self.planner, self.pursuer_planner = planner, pursuer_planner
         self.distance, self.candidate_stride = distance, candidate_stride
         self.hide_margin = hide_margin
-        rows, cols = np.indices(grid.data.shape)
-        #: cell centres (m, map frame) by flat row-major cell index, shape (H * W, 2)
-        self.centres = np.column_stack([v.ravel() for v in grid.cell_to_world(rows, cols)])
-        self._strided = (rows % candidate_stride == 0) & (cols % candidate_stride == 0)
+        stride = np.arange(max(grid.height, grid.width)) % candidate_stride == 0
+        self._strided = stride[: grid.height, None] & stride[None, : grid.width]
         self._half_widths = disc_half_widths(hide_margin, grid.resolution)
         self._component: _Component | None = None
 
@@ -316,16 +382,13 @@ class EscapeSearch:
         if count == 0:
             return Escape(-1, math.inf, 0, np.zeros(0, dtype=np.int64))
         bounds, effort, dist = self._bounds(component, me, pursuer)
-        tiled = component.by_tile
-        cell, cost = _best_candidate(
-            np.argsort(bounds),
+        arguments = (
             bounds,
             component.starts,
-            tiled["cells"],
-            tiled["rows"],
-            tiled["cols"],
-            tiled["xs"],
-            tiled["ys"],
+            component.rows,
+            component.cols,
+            grid.kernel_frame,
+            grid.width,
             exposed,
             top,
             left,
@@ -333,8 +396,21 @@ class EscapeSearch:
             effort,
             dist,
         )
+        # Tiles in increasing bound, the FIRST_TILES lowest sorted first: the search
+        # nearly always stops among them, and sorting every tile of a large map is most
+        # of a decision. The rest follow (sorted) only when it did not.
+        if bounds.size > FIRST_TILES:
+            split = np.argpartition(bounds, FIRST_TILES)
+            first, rest = split[:FIRST_TILES], split[FIRST_TILES:]
+        else:
+            first, rest = np.arange(bounds.size), np.zeros(0, dtype=np.int64)
+        first = first[np.argsort(bounds[first])]
+        cell, cost, stopped = _best_candidate(first, *arguments, -1, math.inf)
+        if not stopped and rest.size:
+            rest = rest[np.argsort(bounds[rest])]
+            cell, cost, stopped = _best_candidate(rest, *arguments, cell, cost)
         step = _sample_step(count, MAX_RECORDED_CANDIDATES)
-        sample = component.cells[_sample_positions(skipped, count, step)]
+        sample = component.cells[_sample_positions(skipped, count, step)].astype(np.int64)
         return Escape(int(cell), float(cost), count, sample)
 
     def escape_reference(self, me: Pose, pursuer: Pose) -> Escape:
@@ -363,13 +439,19 @@ class EscapeSearch:
     def costs(self, me: Pose, pursuer: Pose, cells: np.ndarray) -> np.ndarray:
         """Algorithm 2's cost_escape (dimensionless) of the flat-indexed candidate ``cells``."""
         if self.distance == "euclidean":
-            x, y = self.centres[cells].T
+            x, y = self.centres(cells).T
             effort = np.sqrt((x - me.x) ** 2 + (y - me.y) ** 2)
             dist = np.sqrt((x - pursuer.x) ** 2 + (y - pursuer.y) ** 2)
         else:
             effort = self.planner.distance_field((me.x, me.y)).ravel()[cells]
             dist = self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()[cells]
         return escape_costs(effort, dist)
+
+    def centres(self, cells) -> np.ndarray:
+        """Float (..., 2): the map-frame centres (m) of flat row-major cell indices (an
+        index or an array of them), as :meth:`OccupancyGrid.cell_to_world` gives them."""
+        rows, cols = np.divmod(np.asarray(cells, dtype=np.int64), self.grid.width)
+        return np.stack(self.grid.cell_to_world(rows, cols), axis=-1)
 
     def _component_at(self, me: Pose) -> _Component:
         """The candidate cells of the evader's connected component: the one last used when
@@ -397,7 +479,7 @@ class EscapeSearch:
                 self._component = component
                 return component
         reachable = self.planner.reachable((me.x, me.y))
-        self._component = _Component.build(reachable, self._strided, self.centres)
+        self._component = _Component.build(reachable, self._strided, grid.kernel_frame)
         shared.append(self._component)
         return self._component
 

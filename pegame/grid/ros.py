@@ -87,8 +87,13 @@ def load_map(yaml_path: str | os.PathLike) -> OccupancyGrid:
     path = Path(yaml_path)
     spec = _read_spec(path)
     grey, alpha = _read_image(spec.image, path)
-    data = np.flipud(_occupancy(grey, alpha, spec))
-    return OccupancyGrid(data, spec.resolution, spec.origin, name=path.stem)
+    if grey.dtype == np.uint8:
+        # A grey image: one value per grey level, looked up (a large map's pixels would
+        # otherwise pass through several float arrays of 8 bytes each).
+        values = _occupancy(np.arange(256, dtype=float), None, spec)[grey]
+    else:
+        values = _occupancy(grey, alpha, spec)
+    return OccupancyGrid(np.flipud(values), spec.resolution, spec.origin, name=path.stem)
 
 
 def save_map(grid: OccupancyGrid, yaml_path: str | os.PathLike, image_format: str = "pgm") -> None:
@@ -211,7 +216,8 @@ def _read_spec(path: Path) -> _MapSpec:
 
 
 def _read_image(image_path: Path, yaml_path: Path) -> tuple[np.ndarray, np.ndarray | None]:
-    """Image -> (grey (H, W) float mean of the colour channels, alpha (H, W) uint8 or None).
+    """Image -> (grey (H, W), alpha (H, W) uint8 or None): grey is the uint8 pixels of
+    a grey image (alpha None), else the float mean of the colour channels.
 
     Rows are in image order (row 0 = top).
     """
@@ -240,7 +246,7 @@ def _read_image(image_path: Path, yaml_path: Path) -> tuple[np.ndarray, np.ndarr
             raise _fail(yaml_path, f"image {image_path} is corrupt ({exc}).") from exc
         has_alpha = converted.mode.endswith("A")
     if pixels.ndim == 2:
-        return pixels.astype(float), None
+        return pixels.astype(np.uint8, copy=False), None
     colour = pixels[..., :-1] if has_alpha else pixels
     grey = colour.sum(axis=2, dtype=float) / colour.shape[2]
     return grey, pixels[..., -1] if has_alpha else None

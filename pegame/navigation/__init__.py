@@ -23,14 +23,14 @@ costs are in metres.
 
 from pegame.navigation.follower import PathFollower
 from pegame.navigation.inflation import inflate, obstacle_distance, shared_inflation
-from pegame.navigation.planner import LARGE_GRID_CELLS, LARGE_GRID_LANDMARKS, PathResult, Planner
+from pegame.navigation.planner import LARGE_GRID_CELLS, TIE_QUANTUM, PathResult, Planner
 
 __all__ = [
     "LARGE_GRID_CELLS",
-    "LARGE_GRID_LANDMARKS",
     "PathFollower",
     "PathResult",
     "Planner",
+    "TIE_QUANTUM",
     "inflate",
     "obstacle_distance",
     "shared_inflation",

@@ -27,10 +27,12 @@ from pegame.grid import OccupancyGrid, per_grid, read_only
 from pegame.navigation.inflation import DISTANCE_TOLERANCE, shared_obstacle_distance
 from pegame.navigation.search import MOVES, allowed_moves, astar, dijkstra, pad_flat
 
-#: grids with at least this many cells get landmarks by default (see Planner)
+#: grids with at least this many cells round A*'s keys by default (see Planner); the
+#: paper's maps have at most 120 000
 LARGE_GRID_CELLS = 1_000_000
-#: landmarks of a planner on a large grid by default
-LARGE_GRID_LANDMARKS = 12
+#: m; A* rounds its keys down to multiples of this on large grids (see search.astar): far
+#: above the round-off of a path cost (below 1e-9 m on a 4000 x 4000 grid), far below a cell
+TIE_QUANTUM = 1e-8
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,7 +43,8 @@ class PathResult:
     exact goal point when its cell is traversable; empty when unreachable. length: the
     polyline length of ``path`` (m). cost: the weighted grid cost of the cell path (m,
     see :class:`Planner`); inf when unreachable. reachable: whether a path was found.
-    reason: '' when reachable, else why not.
+    reason: '' when reachable, else why not. searched: how many cells the search reached
+    (its work and memory; 0 when no search ran).
     """
 
     path: np.ndarray
@@ -49,6 +52,7 @@ class PathResult:
     reachable: bool
     reason: str = ""
     cost: float = math.inf
+    searched: int = 0
 
 
 def _unreachable(reason: str) -> PathResult:
@@ -67,12 +71,19 @@ class Planner:
     length, so paths keep clear of walls when they can (no extra cost when clearance is
     0). goal_snap (m): how far a goal in a non-traversable cell may be moved (see
     :meth:`plan`). landmarks: how many landmark cost fields sharpen the A* heuristic (ALT,
-    see :meth:`_landmark_table`); 0 keeps the octile heuristic alone, and None (the
-    default) means LARGE_GRID_LANDMARKS on grids of at least LARGE_GRID_CELLS cells and 0
-    on smaller ones, such as the paper's maps. Landmarks cost one weighted distance field
-    each at the first plan and 8 bytes per cell each; on a large map a long search then
-    visits several times fewer cells. Paths stay optimal, but among equal-cost paths a
-    different one may be chosen than with the octile heuristic alone.
+    see :meth:`_landmark_table`); 0 (the default) keeps the octile heuristic alone.
+    Landmarks cost one full weighted distance field each at the first plan and 4 bytes
+    per cell each; on a large open grid they shorten the longest searches (a few times)
+    but not the short ones a game makes, so they pay only when one process plans many
+    long paths on one map. Paths stay optimal, but among equal-cost paths a different one
+    may be chosen than with the octile heuristic alone. tie_quantum (m): A*'s keys are
+    rounded down to multiples of it (see :func:`pegame.navigation.search.astar`; 0 keeps
+    exact keys); None (the default) means TIE_QUANTUM on grids of at least
+    LARGE_GRID_CELLS cells and 0 on smaller ones. Exact keys flood open areas with
+    near-ties: a 200 m search across a free 4000 x 4000 grid expands millions of cells
+    with them and not many more than the path's with rounded ones. The paper's maps keep
+    exact keys, so their games stay exactly as they were (rounded keys pick other paths
+    among equal-cost ones).
     """
 
     def __init__(
@@ -83,7 +94,8 @@ class Planner:
         clearance: float = 0.5,
         clearance_weight: float = 2.0,
         goal_snap: float = 1.0,
-        landmarks: int | None = None,
+        landmarks: int = 0,
+        tie_quantum: float | None = None,
     ) -> None:
         for key, value in [
             ("radius", radius),
@@ -91,7 +103,8 @@ class Planner:
             ("clearance", clearance),
             ("clearance_weight", clearance_weight),
             ("goal_snap", goal_snap),
-            ("landmarks", 0 if landmarks is None else landmarks),
+            ("landmarks", landmarks),
+            ("tie_quantum", 0.0 if tie_quantum is None else tie_quantum),
         ]:
             # A non-negative clearance_weight also keeps every step at least as costly as
             # its length, which the A* heuristic and the bucket queue rely on.
@@ -102,26 +115,35 @@ class Planner:
         inflation = radius + margin
         distance = shared_obstacle_distance(grid)
         self.traversable = read_only(distance > inflation + DISTANCE_TOLERANCE)
-        beyond = distance - inflation
+        # The multipliers are written straight into the kernels' padded array (ring 1.0),
+        # in place: on a large map every full-size temporary costs 8 bytes per cell.
+        padded = np.ones((grid.height + 2, grid.width + 2))
+        multipliers = padded[1:-1, 1:-1]
         if clearance > 0:
-            penalty = np.clip(1.0 - beyond / clearance, 0.0, 1.0)
-        else:
-            penalty = np.zeros_like(distance)
-        self.multipliers = read_only(1.0 + clearance_weight * penalty)
+            # 1 + clearance_weight * clip(1 - beyond / clearance, 0, 1), beyond = distance - inflation
+            np.subtract(distance, inflation, out=multipliers)
+            multipliers /= clearance
+            np.subtract(1.0, multipliers, out=multipliers)
+            np.clip(multipliers, 0.0, 1.0, out=multipliers)
+            multipliers *= clearance_weight
+            multipliers += 1.0
+        #: float (H, W) step cost multipliers (>= 1), a view of the kernels' padded array
+        self.multipliers = read_only(multipliers)
+        self._padded_multipliers = read_only(padded.ravel())
         # Components under the planner's moves: without corner cutting these are the
         # 4-connected components (labels 1.., 0 for non-traversable cells).
         self._labels = read_only(ndimage.label(self.traversable)[0])
         self._any_traversable = bool(self.traversable.any())
         self._nearest: np.ndarray | None = None  # see _nearest_cells
         self._padded_width = grid.width + 2
-        self._allowed = allowed_moves(pad_flat(self.traversable, False), self._padded_width, MOVES)
-        self._padded_multipliers = pad_flat(self.multipliers, 1.0)
+        self._allowed = allowed_moves(self.traversable)
         # Search scratch memory, allocated at the first search that needs it.
         self._astar_scratch: tuple[np.ndarray, ...] | None = None
         self._bucket_pool: tuple[np.ndarray, np.ndarray] | None = None
-        if landmarks is None:
-            landmarks = LARGE_GRID_LANDMARKS if grid.data.size >= LARGE_GRID_CELLS else 0
         self.landmarks = int(landmarks)
+        if tie_quantum is None:
+            tie_quantum = TIE_QUANTUM if grid.data.size >= LARGE_GRID_CELLS else 0.0
+        self.tie_quantum = float(tie_quantum)
         self._landmarks: np.ndarray | None = None  # see _landmark_table
 
     @classmethod
@@ -214,46 +236,62 @@ class Planner:
             self._bucket_pool = (np.empty(8 * n + 1, np.int32), np.empty(8 * n + 1, np.int32))
 
     def _landmark_table(self) -> np.ndarray:
-        """Float (landmarks, n): weighted path costs (m) from each landmark cell to every flat
-        padded cell, 0 where unreachable. Built at the first need.
+        """Float32 (landmarks, n): weighted path costs (m) from each landmark cell to every
+        flat padded cell, scaled by a factor s slightly below 1 (see below), 0 where
+        unreachable. Built at the first need.
 
         For a landmark L and cells v, goal, |cost(L, goal) - cost(L, v)| is a lower bound of
         cost(v, goal) (triangle inequality; moves cost the same both ways), so A* may use the
         largest of these bounds and the octile distance. Landmarks are placed by farthest
         points in the largest connected region: each one is the cell farthest from those
         chosen so far, the first the farthest from the region's first cell. Cells in other
-        regions get 0 bounds, which is admissible too. (Costs rounded to float32 would halve
-        the memory, but the rounding makes the heuristic slightly inconsistent, and A* then
-        re-expands so many cells that most of the gain is lost.)
+        regions get 0 bounds, which is admissible too.
+
+        Float32 halves the table, but rounding each cost by up to 2^-24 of itself would
+        make the heuristic inconsistent by that much, and A* then re-expands so many cells
+        that most of the gain is lost. So the costs are scaled by s = 1 - 2^-22 D / r
+        before rounding, D the largest cost and r the resolution (the cheapest step): for
+        adjacent cells u, v the stored a_u, a_v then satisfy |a_u - a_v| <= s c(u, v) +
+        2^-23 s D <= c(u, v), which makes the bounds (computed in float64) consistent;
+        they lose a fraction 1 - s of their strength (0.1 % for a 300 m cost at 5 cm).
+        When s would fall below 1/2 (costs beyond 2^21 cells) the table stays zero.
         """
         if self._landmarks is None:
-            costs = np.zeros((self.landmarks, self._allowed.size))
+            costs = np.zeros((self.landmarks, self._allowed.size), np.float32)
             if self.landmarks and self._any_traversable:
                 region = np.argmax(np.bincount(self._labels.ravel())[1:]) + 1
                 cell = np.unravel_index(np.argmax(self._labels == region), self._labels.shape)
                 nearest = self.distance_field(self.grid.cell_to_world(*cell), weighted=True)
+                fields = []
                 for k in range(self.landmarks):
                     farthest = np.argmax(np.where(np.isfinite(nearest), nearest, -1.0))
                     cell = np.unravel_index(farthest, nearest.shape)
                     field = self.distance_field(self.grid.cell_to_world(*cell), weighted=True)
-                    costs[k] = pad_flat(np.where(np.isfinite(field), field, 0.0), 0.0)
+                    fields.append(np.where(np.isfinite(field), field, 0.0))
                     nearest = field if k == 0 else np.minimum(nearest, field)
+                largest = max(float(field.max()) for field in fields)
+                scale = 1.0 - 2.0**-22 * largest / self.grid.resolution
+                if scale >= 0.5:
+                    for k, field in enumerate(fields):
+                        costs[k] = pad_flat(scale * field, 0.0)
             self._landmarks = read_only(costs)
         return self._landmarks
 
     def _search_scratch(self) -> tuple[np.ndarray, ...]:
-        """A*'s scratch arrays (g, parent, keys, ties, nodes, pos, touched), g all inf and
-        pos all -1 between searches."""
+        """A*'s scratch arrays (g, parent, keys, ties, nodes, pos, touched, seen), seen all
+        False between searches. All are left uninitialised or zeroed by the system (see
+        search.astar), so a search uses the memory of the cells it reaches only."""
         if self._astar_scratch is None:
             n = self._allowed.size
             self._astar_scratch = (
-                np.full(n, np.inf),
+                np.empty(n),
                 np.empty(n, np.int32),
                 np.empty(n),
                 np.empty(n),
                 np.empty(n, np.int32),
-                np.full(n, -1, np.int32),
                 np.empty(n, np.int32),
+                np.empty(n, np.int32),
+                np.zeros(n, np.bool_),
             )
         return self._astar_scratch
 
@@ -303,7 +341,7 @@ class Planner:
                 if not self.grid.contains(row, col):
                     return _unreachable("goal is outside the map")
                 return _unreachable("goal is inside an obstacle")
-        cost, cells = astar(
+        cost, cells, searched = astar(
             self._allowed,
             self._padded_multipliers,
             self.grid.resolution,
@@ -312,6 +350,7 @@ class Planner:
             self._flat(goal),
             MOVES,
             self._landmark_table(),
+            self.tie_quantum,
             *self._search_scratch(),
         )
         rows, cols = np.divmod(cells, self._padded_width)
@@ -320,4 +359,4 @@ class Planner:
         if exact_goal:
             path = np.vstack([path, np.asarray(goal_xy, dtype=float).reshape(1, 2)])
         length = float(np.hypot(*np.diff(path, axis=0).T).sum())
-        return PathResult(path, length, True, "", float(cost))
+        return PathResult(path, length, True, "", float(cost), int(searched))

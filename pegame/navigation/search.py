@@ -48,26 +48,25 @@ def _move_tables(padded_width, moves, resolution):
     return offsets, lengths
 
 
-@njit(cache=True)
-def allowed_moves(traversable, padded_width, moves):
-    """Uint8 per flat padded cell: bit k set when move k is allowed from the cell, i.e. the
-    cell and its target are traversable and, for a diagonal move, so are the two cells it
-    passes between."""
-    allowed = np.zeros(traversable.size, dtype=np.uint8)
-    offsets = moves[:, 0] * padded_width + moves[:, 1]
-    for u in range(padded_width, traversable.size - padded_width):
-        if not traversable[u]:
-            continue
-        for k in range(8):
-            if not traversable[u + offsets[k]]:
-                continue
-            if moves[k, 0] != 0 and moves[k, 1] != 0:
-                if not (
-                    traversable[u + moves[k, 0] * padded_width] and traversable[u + moves[k, 1]]
-                ):
-                    continue
-            allowed[u] |= 1 << k
-    return allowed
+def allowed_moves(traversable: np.ndarray) -> np.ndarray:
+    """Uint8 per flat padded cell of the bool (H, W) ``traversable``: bit k set when move
+    k of MOVES is allowed from the cell, i.e. the cell and its target are traversable
+    and, for a diagonal move, so are the two cells it passes between. One vectorised
+    pass per move over the whole grid (the padding ring allows no move)."""
+    height, width = traversable.shape
+    padded = np.pad(traversable, 1, constant_values=False)
+    allowed = np.zeros(padded.shape, dtype=np.uint8)
+
+    def shifted(dr: int, dc: int) -> np.ndarray:
+        return padded[1 + dr : height + 1 + dr, 1 + dc : width + 1 + dc]
+
+    for k, (dr, dc) in enumerate(MOVES.tolist()):
+        ok = traversable & shifted(dr, dc)
+        if dr and dc:
+            ok &= shifted(dr, 0)
+            ok &= shifted(0, dc)
+        allowed[1:-1, 1:-1] |= ok.view(np.uint8) << k
+    return allowed.ravel()
 
 
 @njit(cache=True)
@@ -212,6 +211,7 @@ def astar(
     goal,
     moves,
     landmark_costs,
+    tie_quantum,
     g,
     parent,
     keys,
@@ -219,32 +219,55 @@ def astar(
     nodes,
     pos,
     touched,
+    seen,
 ):
-    """Minimum weighted cost (m) and flat cell path from ``start`` to ``goal`` by A*.
+    """Minimum weighted cost (m), flat cell path and number of cells reached from
+    ``start`` to ``goal`` by A*.
 
     The heuristic is the octile distance, admissible and consistent because every
     multiplier is >= 1, or the larger landmark bound when ``landmark_costs`` (K, n) has
-    rows (see ``Planner._landmark_table``). Returns (inf, empty) when the goal is
-    unreachable. The other arrays (length n) are scratch: ``g`` must be all inf and
-    ``pos`` all -1 on entry, and both are restored before returning (only the ``touched``
-    cells are reset, not the whole grid).
+    rows (see ``Planner._landmark_table``). Returns (inf, empty, reached) when the goal is
+    unreachable.
+
+    The heap orders cells by f = g + h, then by the smaller h. With ``tie_quantum`` q > 0
+    (m) f is first rounded down to a multiple of q: on an open grid every cell of the
+    parallelogram between start and goal lies on an optimal octile path, but their f
+    differ in the last bits (g sums the steps in different orders), so the exact key
+    never ties and A* expands most of the parallelogram (a 200 m search across a free
+    map visits millions of cells). Rounded keys tie, the smaller h goes first and the
+    search runs along one optimal path. A popped cell is then closed (never improved
+    again): with rounded keys a cell may be popped with a g larger than its least by
+    round-off, and reopening it would re-expand everything after it, again and again.
+    The cost found is optimal to within q per step of the path. q = 0 keeps the exact key
+    and no closed set (the paper maps' searches).
+
+    The other arrays (length n) are scratch. ``seen`` (bool) must be all False on entry
+    and is restored before returning (only the ``touched`` cells are reset, not the whole
+    grid); the others are read only where ``seen`` is set (a cell's g, heap slot and
+    parent are written when the search first reaches it), so they may be allocated
+    uninitialised and only the memory pages of the cells a search reaches are ever
+    used: on a large map a short search costs little memory.
     """
     offsets, lengths = _move_tables(padded_width, moves, resolution)
     goal_row, goal_col = goal // padded_width, goal % padded_width
     to_goal = landmark_costs[:, goal].copy()
     g[start] = 0.0
+    pos[start] = -1
+    seen[start] = True
     touched[0] = start
     count = 1
     parent[start] = -1
     h = _octile(resolution, start // padded_width, start % padded_width, goal_row, goal_col)
     h = _landmark_bound(landmark_costs, to_goal, start, h)
-    _sift_up(keys, ties, nodes, pos, 0, start, h, h)
+    _sift_up(keys, ties, nodes, pos, 0, start, _key(h, tie_quantum), h)
     size = 1
     while size > 0:
         u = _pop(keys, ties, nodes, pos, size)
         size -= 1
         if u == goal:
             break
+        if tie_quantum > 0.0:
+            pos[u] = CLOSED
         row, col = u // padded_width, u % padded_width
         moves_u = allowed[u]
         for k in range(8):
@@ -252,10 +275,13 @@ def astar(
                 continue
             v = u + offsets[k]
             candidate = g[u] + lengths[k] * (0.5 * (multipliers[u] + multipliers[v]))
-            if candidate < g[v]:
-                if g[v] == np.inf:
-                    touched[count] = v
-                    count += 1
+            if not seen[v]:
+                seen[v] = True
+                touched[count] = v
+                count += 1
+                g[v] = np.inf
+                pos[v] = -1
+            if candidate < g[v] and pos[v] != CLOSED:
                 g[v] = candidate
                 parent[v] = u
                 h = _octile(resolution, row + moves[k, 0], col + moves[k, 1], goal_row, goal_col)
@@ -265,20 +291,33 @@ def astar(
                 slot = pos[v] if pos[v] >= 0 else size
                 if pos[v] < 0:
                     size += 1
-                _sift_up(keys, ties, nodes, pos, slot, v, candidate + h, h)
-    cost = g[goal]
+                _sift_up(keys, ties, nodes, pos, slot, v, _key(candidate + h, tie_quantum), h)
+    cost = g[goal] if seen[goal] else np.inf
     path = _trace(parent, start, goal) if np.isfinite(cost) else np.empty(0, dtype=np.int64)
     for i in range(count):
-        g[touched[i]] = np.inf
-        pos[touched[i]] = -1
-    return cost, path
+        seen[touched[i]] = False
+    return cost, path, count
+
+
+#: ``pos`` of a cell A* has closed (with a tie quantum only)
+CLOSED = -2
+
+
+@njit(cache=True)
+def _key(f, tie_quantum):
+    """The heap key of f (m): f itself, or f rounded down to a multiple of ``tie_quantum``."""
+    if tie_quantum > 0.0:
+        return math.floor(f / tie_quantum) * tie_quantum
+    return f
 
 
 @njit(cache=True)
 def _landmark_bound(landmark_costs, to_goal, v, h):
-    """The largest of ``h`` and the landmark bounds |cost(L, goal) - cost(L, v)| (m)."""
+    """The largest of ``h`` and the landmark bounds |cost(L, goal) - cost(L, v)| (m),
+    subtracted in float64 (exactly, for float32 costs: the consistency argument of
+    ``Planner._landmark_table`` needs the difference unrounded)."""
     for k in range(to_goal.size):
-        h = max(h, abs(to_goal[k] - landmark_costs[k, v]))
+        h = max(h, abs(np.float64(to_goal[k]) - np.float64(landmark_costs[k, v])))
     return h
 
 
