@@ -13,7 +13,7 @@ compiles for the same expression:
 - :func:`pegame.types.wrap_angle` is the IEEE remainder by 2 pi, which numba does not
   compile. :func:`wrap_angle` computes it exactly for the angles a game produces (|angle|
   up to 3 pi, where the remainder is one exact subtraction, Sterbenz's lemma) and falls
-  back to the floored modulo beyond (exact too, as fmod is, then one exact correction).
+  back to Python's floored modulo and one correction beyond.
 
 Both are compared with the Python functions in ``tests/test_vector_kernels.py``.
 """
@@ -54,7 +54,8 @@ def _product(x, y):
 
 @njit(cache=True)
 def hypot(x, y):
-    """``math.hypot(x, y)`` of CPython 3.10+, bit for bit (module docstring)."""
+    """``math.hypot(x, y)`` of CPython 3.10+, bit for bit (module docstring), unless the
+    larger magnitude is subnormal (below 2.2e-308 m: no game has such lengths)."""
     x, y = abs(x), abs(y)
     if math.isinf(x) or math.isinf(y):
         return math.inf
@@ -64,9 +65,8 @@ def hypot(x, y):
     if biggest == 0.0:
         return biggest
     exponent = math.frexp(biggest)[1]
-    if exponent < -1023:  # subnormal: CPython rescales by DBL_MIN first
-        tiny = 2.2250738585072014e-308
-        return tiny * hypot(x / tiny, y / tiny)
+    if exponent < -1021:  # subnormal: not in any game; the C library's hypot
+        return math.hypot(x, y)
     scale = math.ldexp(1.0, -exponent)
     csum, frac1, frac2 = 1.0, 0.0, 0.0
     for value in (x, y):

@@ -9,14 +9,14 @@ plain-Python code plays (``tests/test_vector_env.py`` compares them step by step
   acceleration limits, exact unicycle arc, the swept collision check
   :func:`pegame.sims.grid._sweep` itself);
 - :func:`point_in_view` and :func:`body_in_view` are :func:`pegame.visibility.in_view` and
-  :func:`pegame.visibility.body_in_view` (the line of sight is
-  :func:`pegame.visibility.sight._segment_clear` itself);
+  :func:`pegame.visibility.body_in_view`, the line of sight :func:`segment_clear` that of
+  :func:`pegame.visibility.sight._segment_clear`;
 - :func:`detect` is the oracle detector with every part of the perception model off
   (:class:`pegame.detectors.oracle.OracleDetector`: FOV, range and line of sight of the
   evader's centre, then the pinhole box and the depth back-projection);
 - :func:`pursuer_features` and :func:`evader_features` are
   :class:`pegame.envs.observations.PursuerFeatures` and ``EvaderFeatures``, with the crop
-  of :func:`pegame.envs.crop._crop`;
+  of :func:`pegame.envs.crop._crop` (:func:`crop_into`);
 - :func:`tally` accumulates :class:`pegame.metrics.TrackingMetrics` as running sums
   (:mod:`pegame.vector.metrics` turns them into its summary).
 
@@ -36,11 +36,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from pegame.envs.crop import _crop
 from pegame.envs.observations import AGE_SCALE
 from pegame.sims.grid import _sweep
 from pegame.vector.exact import hypot, wrap_angle
-from pegame.visibility.sight import SILHOUETTE, _segment_clear
+from pegame.visibility.sight import SILHOUETTE
 
 PURSUER, EVADER = 0, 1
 
@@ -202,6 +201,44 @@ def move(world, rules, state, game, role, dt):
         state.velocities[game, role, 1] = w
 
 
+#: line-of-sight samples whose cells are found together (one vectorised pass)
+_CHUNK = 32
+
+
+@njit(cache=True)
+def segment_clear(world, ax, ay, bx, by, step):
+    """:func:`pegame.visibility.sight._segment_clear` on the grid: True when no sample of
+    the segment from (ax, ay) to (bx, by) (m), ``step`` m apart, lies in a blocked or
+    off-grid cell. The same samples and cells (the tests compare the two), found
+    _CHUNK at a time in a loop that LLVM vectorises, then looked up; the test stops at
+    the first chunk with a blocked cell."""
+    frame, blocked = world.frame, world.blocked
+    height, width = blocked.shape
+    flat = blocked.ravel()
+    ox, oy, gc, gs, rotated, res = frame[0], frame[1], frame[2], frame[3], frame[4] != 0.0, frame[5]
+    count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
+    dx, dy = bx - ax, by - ay
+    dt = 1.0 / count
+    cells = np.empty(_CHUNK, np.int64)
+    for start in range(0, count + 1, _CHUNK):
+        size = min(_CHUNK, count + 1 - start)
+        for j in range(size):
+            k = start + j
+            t = 1.0 if k == count else k * dt
+            u = ax + t * dx - ox
+            v = ay + t * dy - oy
+            if rotated:
+                u, v = gc * u + gs * v, -gs * u + gc * v
+            qc, qr = u / res, v / res
+            inside = (qr >= 0.0) & (qr < height) & (qc >= 0.0) & (qc < width)
+            cells[j] = np.int64(qr) * width + np.int64(qc) if inside else -1
+        for j in range(size):
+            cell = cells[j]
+            if cell < 0 or flat[cell]:
+                return False
+    return True
+
+
 @njit(cache=True)
 def point_in_view(world, camera, px, py, ptheta, x, y):
     """:func:`pegame.visibility.in_view` of the map point (x, y) (m) from the camera at
@@ -212,17 +249,20 @@ def point_in_view(world, camera, px, py, ptheta, x, y):
         return False
     if abs(wrap_angle(math.atan2(dy, dx) - ptheta)) > 0.5 * camera[FOV]:
         return False
-    return _segment_clear(world.blocked, px, py, x, y, 0.5 * world.frame[5], world.frame)
+    return segment_clear(world, px, py, x, y, 0.5 * world.frame[5])
 
 
 @njit(cache=True)
-def body_in_view(world, camera, px, py, ptheta, x, y, radius):
+def body_in_view(world, camera, px, py, ptheta, x, y, radius, centre):
     """:func:`pegame.visibility.body_in_view`: any SILHOUETTE point of the body of
-    ``radius`` m at (x, y) in view."""
+    ``radius`` m at (x, y) in view; ``centre``: whether its centre (the first point,
+    x + 0 = x) is, already known from the detector."""
+    if centre:
+        return True
     dx, dy = x - px, y - py
     distance = hypot(dx, dy)
     ax, ay = (-dy / distance, dx / distance) if distance > 0.0 else (0.0, 0.0)
-    for k in _SILHOUETTE:
+    for k in _SILHOUETTE[1:]:
         if point_in_view(world, camera, px, py, ptheta, x + k * radius * ax, y + k * radius * ay):
             return True
     return False
@@ -231,16 +271,17 @@ def body_in_view(world, camera, px, py, ptheta, x, y, radius):
 @njit(cache=True)
 def detect(world, rules, state, game):
     """The oracle detector's capture for ``game``'s current poses, into state.detected
-    and state.detection (the pipeline's parts all off)."""
+    and state.detection (the pipeline's parts all off). Returns whether the evader's
+    centre is in view."""
     camera = rules.camera
     cx, cy, ctheta = state.poses[game, PURSUER]
     ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
     state.detected[game] = False
     if not point_in_view(world, camera, cx, cy, ctheta, ex, ey):
-        return
+        return False
     distance = hypot(ex - cx, ey - cy)
     if not distance <= camera[DETECTION_RANGE]:
-        return
+        return True
     bearing = wrap_angle(math.atan2(ey - cy, ex - cx) - ctheta)
     depth = distance * math.cos(bearing)
     depth = depth if depth > camera[NEAR] else camera[NEAR]
@@ -268,17 +309,18 @@ def detect(world, rules, state, game):
     out[SEEN_X] = cx + seen_range * math.cos(heading)
     out[SEEN_Y] = cy + seen_range * math.sin(heading)
     state.detected[game] = True
+    return True
 
 
 @njit(cache=True)
 def sense(world, rules, state, game):
     """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
     pursuer observation's memory of the last detection (``PursuerFeatures.remember``)."""
-    detect(world, rules, state, game)
+    centre = detect(world, rules, state, game)
     px, py, ptheta = state.poses[game, PURSUER]
     ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
     state.in_view[game] = body_in_view(
-        world, rules.camera, px, py, ptheta, ex, ey, rules.bodies[EVADER, RADIUS]
+        world, rules.camera, px, py, ptheta, ex, ey, rules.bodies[EVADER, RADIUS], centre
     )
     if state.detected[game]:
         state.seen[game, 0] = state.steps[game] * rules.control_dt
@@ -376,23 +418,31 @@ def _pose_features(world, x, y, theta, out, at):
 
 
 @njit(cache=True)
-def _crop_into(world, x, y, theta, out, at):
-    _crop(
-        world.pooled,
-        world.crop_x,
-        world.crop_y,
-        x,
-        y,
-        math.cos(theta),
-        math.sin(theta),
-        world.crop_frame[0],
-        world.crop_frame[1],
-        world.crop_frame[2],
-        world.crop_frame[3],
-        world.crop_frame[4] != 0.0,
-        world.crop_frame[5],
-        out[at:],
-    )
+def crop_into(world, x, y, theta, out, at):
+    """The crop of :class:`pegame.envs.crop.LocalCrop` around (x, y, theta) into
+    out[at:], with the float operations of :func:`pegame.envs.crop._crop` (compared with it
+    in the tests), in two passes so that LLVM vectorises the first: every cell's flat
+    index in the pooled map (-1 off the map), then the look-ups. A quotient q = d / res
+    in [0, n) is exactly a cell floor(q) in [0, n), and there truncation is the floor."""
+    pooled = world.pooled
+    height, width = pooled.shape
+    flat = pooled.ravel()
+    off_x, off_y = world.crop_x, world.crop_y
+    c, s = math.cos(theta), math.sin(theta)
+    gx, gy, gc, gs = world.crop_frame[0], world.crop_frame[1], world.crop_frame[2], world.crop_frame[3]
+    rotate, res = world.crop_frame[4] != 0.0, world.crop_frame[5]
+    cells = np.empty(off_x.size, np.int64)
+    for k in range(off_x.size):
+        dx = x + (c * off_x[k] - s * off_y[k]) - gx
+        dy = y + (s * off_x[k] + c * off_y[k]) - gy
+        if rotate:
+            dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
+        qc, qr = dx / res, dy / res
+        inside = (qr >= 0.0) & (qr < height) & (qc >= 0.0) & (qc < width)
+        cells[k] = np.int64(qr) * width + np.int64(qc) if inside else -1
+    for k in range(off_x.size):
+        cell = cells[k]
+        out[at + k] = 1.0 if cell < 0 or flat[cell] else 0.0
 
 
 @njit(cache=True, parallel=True)
@@ -411,7 +461,7 @@ def pursuer_features(world, rules, state, out):
             row[5] = min(1.0, hypot(dx, dy) / far)
             row[6] = wrap_angle(math.atan2(dy, dx) - ptheta) / math.pi
             row[7] = min(1.0, (state.steps[game] * rules.control_dt - state.seen[game, 0]) / AGE_SCALE)
-        _crop_into(world, px, py, ptheta, row, 8)
+        crop_into(world, px, py, ptheta, row, 8)
 
 
 @njit(cache=True, parallel=True)
@@ -430,4 +480,4 @@ def evader_features(world, state, out):
         row[9] = _unit((-s * dx + c * dy) / diagonal)
         row[10] = math.cos(ptheta - etheta)
         row[11] = math.sin(ptheta - etheta)
-        _crop_into(world, ex, ey, etheta, row, 12)
+        crop_into(world, ex, ey, etheta, row, 12)
