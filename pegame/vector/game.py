@@ -191,10 +191,9 @@ class BatchedGame:
     def observations(self, role: str) -> np.ndarray:
         """Float32 (N, size): ``role``'s observation in every game (a new array)."""
         out = np.empty((self.num_games, self.features[role].size), dtype=np.float32)
-        if role == "pursuer":
-            kernels.pursuer_features(self.world, self.rules, self.state, out)
-        else:
-            kernels.evader_features(self.world, self.state, out)
+        kernels.features(
+            self.world, self.rules, self.state, out, PURSUER if role == "pursuer" else EVADER
+        )
         return out
 
     def time(self) -> np.ndarray:

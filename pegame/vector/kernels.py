@@ -1,7 +1,7 @@
 """Numba kernels of the batched game: one control tick of many games at once.
 
-Each kernel loops over the games with ``prange`` (numba's thread pool, across cores:
-``NUMBA_NUM_THREADS`` sets how many); inside a game the work is the single game's, in the
+Each kernel loops over the games, from PARALLEL_GAMES games on with ``prange`` (numba's
+thread pool, across cores: ``NUMBA_NUM_THREADS`` sets how many); inside a game the work is the single game's, in the
 same order and with the same float operations, so a game played here is the game the
 plain-Python code plays (``tests/test_vector_env.py`` compares them step by step):
 
@@ -14,7 +14,7 @@ plain-Python code plays (``tests/test_vector_env.py`` compares them step by step
 - :func:`detect` is the oracle detector with every part of the perception model off
   (:class:`pegame.detectors.oracle.OracleDetector`: FOV, range and line of sight of the
   evader's centre, then the pinhole box and the depth back-projection);
-- :func:`pursuer_features` and :func:`evader_features` are
+- :func:`features` (per game ``_pursuer_row`` and ``_evader_row``) is
   :class:`pegame.envs.observations.PursuerFeatures` and ``EvaderFeatures``, with the crop
   of :func:`pegame.envs.crop._crop` (:func:`crop_into`);
 - :func:`tally` accumulates :class:`pegame.metrics.TrackingMetrics` as running sums
@@ -74,6 +74,10 @@ BOX_X, BOX_Y, BOX_W, BOX_H, DEPTH, SEEN_X, SEEN_Y = range(7)
 TALLY_SIZE = 17
 
 _SILHOUETTE = np.array(SILHOUETTE)
+
+#: batches of at least this many games are spread over numba's threads (prange); below,
+#: starting the threads costs more than it saves, most of all on a busy machine
+PARALLEL_GAMES = 256
 
 
 class World(NamedTuple):
@@ -379,25 +383,52 @@ def _play_tick(world, rules, state, game, table, table_role):
     state.rewards[game] += state.detected[game]
 
 
+@njit(cache=True)
+def _play_game(world, rules, state, game, playing, ticks, table, table_role):
+    if playing[game]:
+        for _ in range(ticks):
+            if state.steps[game] >= rules.ticks:
+                break
+            _play_tick(world, rules, state, game, table, table_role)
+
+
+@njit(cache=True)
+def _play_serial(world, rules, state, playing, ticks, table, table_role):
+    for game in range(playing.size):
+        _play_game(world, rules, state, game, playing, ticks, table, table_role)
+
+
 @njit(cache=True, parallel=True)
+def _play_parallel(world, rules, state, playing, ticks, table, table_role):
+    for game in prange(playing.size):
+        _play_game(world, rules, state, game, playing, ticks, table, table_role)
+
+
 def play(world, rules, state, playing, ticks, table, table_role):
     """Play up to ``ticks`` control ticks of every game where ``playing`` (bool (N,)) is
     set, each stopping at its last tick; state.rewards counts the detections. ``table``
     (N, decisions, 2): the (v, w) commands of a scripted role ``table_role`` (-1: none) per
-    decision."""
-    for game in prange(playing.size):
-        if playing[game]:
-            for _ in range(ticks):
-                if state.steps[game] >= rules.ticks:
-                    break
-                _play_tick(world, rules, state, game, table, table_role)
+    decision. Parallel over games from PARALLEL_GAMES games on."""
+    kernel = _play_parallel if playing.size >= PARALLEL_GAMES else _play_serial
+    kernel(world, rules, state, playing, ticks, table, table_role)
+
+
+@njit(cache=True)
+def _sense_serial(world, rules, state, games):
+    for k in range(games.size):
+        sense(world, rules, state, games[k])
 
 
 @njit(cache=True, parallel=True)
-def sense_games(world, rules, state, games):
-    """:func:`sense` for the games listed in ``games`` (int (K,)), e.g. just reset."""
+def _sense_parallel(world, rules, state, games):
     for k in prange(games.size):
         sense(world, rules, state, games[k])
+
+
+def sense_games(world, rules, state, games):
+    """:func:`sense` for the games listed in ``games`` (int (K,)), e.g. just reset."""
+    kernel = _sense_parallel if games.size >= PARALLEL_GAMES else _sense_serial
+    kernel(world, rules, state, games)
 
 
 @njit(cache=True, inline="always")
@@ -445,39 +476,59 @@ def crop_into(world, x, y, theta, out, at):
         out[at + k] = 1.0 if cell < 0 or flat[cell] else 0.0
 
 
-@njit(cache=True, parallel=True)
-def pursuer_features(world, rules, state, out):
-    """``PursuerFeatures.build`` (no belief part) of every game into out (N, size)."""
+@njit(cache=True)
+def _pursuer_row(world, rules, state, game, row):
+    """``PursuerFeatures.build`` (no belief part) of ``game`` into ``row``."""
     far = rules.camera[FAR]
-    for game in prange(out.shape[0]):
-        row = out[game]
-        px, py, ptheta = state.poses[game, PURSUER]
-        _pose_features(world, px, py, ptheta, row, 0)
-        row[4] = 1.0 if state.detected[game] else 0.0
-        if not state.has_seen[game]:
-            row[5], row[6], row[7] = 1.0, 0.0, 1.0
+    px, py, ptheta = state.poses[game, PURSUER]
+    _pose_features(world, px, py, ptheta, row, 0)
+    row[4] = 1.0 if state.detected[game] else 0.0
+    if not state.has_seen[game]:
+        row[5], row[6], row[7] = 1.0, 0.0, 1.0
+    else:
+        dx, dy = state.seen[game, 1] - px, state.seen[game, 2] - py
+        row[5] = min(1.0, hypot(dx, dy) / far)
+        row[6] = wrap_angle(math.atan2(dy, dx) - ptheta) / math.pi
+        row[7] = min(1.0, (state.steps[game] * rules.control_dt - state.seen[game, 0]) / AGE_SCALE)
+    crop_into(world, px, py, ptheta, row, 8)
+
+
+@njit(cache=True)
+def _evader_row(world, rules, state, game, row):
+    """``EvaderFeatures.build`` of ``game`` into ``row``."""
+    diagonal = world.extent[4]
+    ex, ey, etheta = state.poses[game, EVADER]
+    px, py, ptheta = state.poses[game, PURSUER]
+    _pose_features(world, ex, ey, etheta, row, 0)
+    _pose_features(world, px, py, ptheta, row, 4)
+    dx, dy = px - ex, py - ey
+    c, s = math.cos(etheta), math.sin(etheta)
+    row[8] = _unit((c * dx + s * dy) / diagonal)
+    row[9] = _unit((-s * dx + c * dy) / diagonal)
+    row[10] = math.cos(ptheta - etheta)
+    row[11] = math.sin(ptheta - etheta)
+    crop_into(world, ex, ey, etheta, row, 12)
+
+
+@njit(cache=True)
+def _features_serial(world, rules, state, out, pursuer):
+    for game in range(out.shape[0]):
+        if pursuer:
+            _pursuer_row(world, rules, state, game, out[game])
         else:
-            dx, dy = state.seen[game, 1] - px, state.seen[game, 2] - py
-            row[5] = min(1.0, hypot(dx, dy) / far)
-            row[6] = wrap_angle(math.atan2(dy, dx) - ptheta) / math.pi
-            row[7] = min(1.0, (state.steps[game] * rules.control_dt - state.seen[game, 0]) / AGE_SCALE)
-        crop_into(world, px, py, ptheta, row, 8)
+            _evader_row(world, rules, state, game, out[game])
 
 
 @njit(cache=True, parallel=True)
-def evader_features(world, state, out):
-    """``EvaderFeatures.build`` of every game into out (N, size)."""
-    diagonal = world.extent[4]
+def _features_parallel(world, rules, state, out, pursuer):
     for game in prange(out.shape[0]):
-        row = out[game]
-        ex, ey, etheta = state.poses[game, EVADER]
-        px, py, ptheta = state.poses[game, PURSUER]
-        _pose_features(world, ex, ey, etheta, row, 0)
-        _pose_features(world, px, py, ptheta, row, 4)
-        dx, dy = px - ex, py - ey
-        c, s = math.cos(etheta), math.sin(etheta)
-        row[8] = _unit((c * dx + s * dy) / diagonal)
-        row[9] = _unit((-s * dx + c * dy) / diagonal)
-        row[10] = math.cos(ptheta - etheta)
-        row[11] = math.sin(ptheta - etheta)
-        crop_into(world, ex, ey, etheta, row, 12)
+        if pursuer:
+            _pursuer_row(world, rules, state, game, out[game])
+        else:
+            _evader_row(world, rules, state, game, out[game])
+
+
+def features(world, rules, state, out, role):
+    """The observation of ``role`` (PURSUER or EVADER) in every game into out (N, size)."""
+    kernel = _features_parallel if out.shape[0] >= PARALLEL_GAMES else _features_serial
+    kernel(world, rules, state, out, role == PURSUER)
