@@ -35,12 +35,17 @@ def evaluate(envs: dict, policies: list[LinearPolicy], seeds: list[int]) -> np.n
     train_cem.evaluate scores one policy (the same games, the same order of the mean).
     ``envs``: opponent -> its batched env of len(policies) * len(seeds) games."""
     rates = np.zeros((len(policies), len(envs), len(seeds)))
+    owner = np.repeat(np.arange(len(policies)), len(seeds))
+    weights = np.stack([policy.weights for policy in policies])[owner]
+    bias = np.stack([policy.bias for policy in policies])[owner]
     for k, env in enumerate(envs.values()):
         obs, _ = env.reset(seed=[seed for _ in policies for seed in seeds])
-        owner = np.repeat(np.arange(len(policies)), len(seeds))
         done = np.zeros(env.num_envs, np.bool_)
         while not done.all():
-            actions = np.stack([policies[c](o) for c, o in zip(owner, obs)]).astype(np.float32)
+            # LinearPolicy.__call__ of every game's candidate at once: a stack of the same
+            # matrix-vector products (tests/test_vector_train.py holds it to the same bits).
+            scores = np.matmul(weights, obs.astype(np.float64)[:, :, None])[:, :, 0]
+            actions = np.tanh(scores + bias).astype(np.float32)
             obs, _, terminated, truncated, info = env.step(actions)
             done = terminated | truncated
         rates[:, k, :] = info["tracking_rate"].reshape(len(policies), len(seeds))

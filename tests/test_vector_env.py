@@ -127,8 +127,16 @@ def test_spaces_are_the_single_envs_batched():
     assert env.action_space.shape == (5, 2)
     obs, info = env.reset(seed=0)
     assert obs in env.observation_space and info["_seed"].all()
-    obs, *_ = env.step(env.action_space.sample())
-    assert obs in env.observation_space
+    assert info["seed"].tolist() == [0, 1, 2, 3, 4]
+    actions = env.action_space.sample()
+    stepped, *_ = env.step(actions)
+    assert stepped in env.observation_space
+    # As gymnasium's env checker asks of a single env: seeded resets are deterministic and
+    # the returned arrays are not reused by later calls.
+    again, _ = env.reset(seed=0)
+    np.testing.assert_array_equal(again, obs)
+    assert not np.shares_memory(again, obs)
+    np.testing.assert_array_equal(env.step(actions)[0], stepped)
 
 
 def test_gymnasium_vector_wrappers_run_on_it():
