@@ -48,7 +48,7 @@ def play_side_by_side(batched, synced, seed: int, steps: int, rng) -> int:
 
 
 @pytest.mark.parametrize(
-    "opponent, model",
+    ("opponent", "model"),
     [("random", "action"), ("random", "waypoint"), ("smart", None)],
 )
 def test_pursuit_plays_the_single_envs_games(opponent, model):
@@ -92,6 +92,7 @@ def test_evasion_against_random_actions_plays_the_single_envs_games():
         ended += int(out_s[3].sum())
     assert ended == 2
 
+
 def test_self_play_plays_the_parallel_envs_game():
     batched = SelfPlayVectorEnv(1, overrides=SHORT)
     single = parallel_env(overrides=SHORT)
@@ -101,7 +102,9 @@ def test_self_play_plays_the_parallel_envs_game():
     for role in ("pursuer", "evader"):
         np.testing.assert_array_equal(obs_b[role][0], obs_s[role])
     for _ in range(20):
-        actions = {role: rng.uniform(-1, 1, (1, 2)).astype(np.float32) for role in ("pursuer", "evader")}
+        actions = {
+            role: rng.uniform(-1, 1, (1, 2)).astype(np.float32) for role in ("pursuer", "evader")
+        }
         obs_b, rew_b, _, trunc_b, info_b = batched.step(actions)
         obs_s, rew_s, _, trunc_s, info_s = single.step({r: a[0] for r, a in actions.items()})
         for role in ("pursuer", "evader"):

@@ -12,7 +12,10 @@ from pegame.envs.crop import local_crop_reference
 from pegame.envs.vector import vector_env
 from pegame.sims.grid import _Agent
 from pegame.types import Pose, Velocity, wrap_angle
+from pegame.vector import camera as batched_camera
 from pegame.vector import exact, kernels
+from pegame.vector.features import crop_into
+from pegame.vector.state import new_state
 from pegame.visibility import body_in_view, in_view
 
 
@@ -53,7 +56,7 @@ def test_crop_is_the_reference_crop(game):
     for x, y, theta in zip(
         rng.uniform(x0 - 2, x1 + 2, 200), rng.uniform(y0 - 2, y1 + 2, 200), rng.uniform(-4, 4, 200)
     ):
-        kernels.crop_into(world, x, y, theta, out, 0)
+        crop_into(world, x, y, theta, out, 0)
         want = local_crop_reference(
             grid, x, y, theta, settings.crop_cells, settings.crop_resolution
         ).ravel()
@@ -74,8 +77,8 @@ def test_in_view_tests_are_the_visibility_functions(game):
         theta = math.atan2(ey - py, ex - px) + rng.uniform(-0.7, 0.7)
         pose = Pose(px, py, theta)
         centre = in_view(grid, camera, pose, (ex, ey))
-        assert kernels.point_in_view(world, numbers, px, py, theta, ex, ey) == centre
-        body = kernels.body_in_view(world, numbers, px, py, theta, ex, ey, 0.25, centre)
+        assert batched_camera.point_in_view(world, numbers, px, py, theta, ex, ey) == centre
+        body = batched_camera.body_in_view(world, numbers, px, py, theta, ex, ey, 0.25, centre)
         assert body == body_in_view(grid, camera, pose, (ex, ey), 0.25)
         seen += centre
     assert 100 < seen < 2900  # both outcomes were tested
@@ -87,7 +90,7 @@ def test_move_is_the_grid_simulators(game, a_max):
     body = context.pursuer.__class__(context.pursuer.radius, 0.5, 1.8, a_max, 2 * a_max)
     agent = _Agent(grid, body)
     rules = game.rules._replace(bodies=np.array([[body.radius, 0.5, 1.8, a_max, 2 * a_max]] * 2))
-    state = kernels.new_state(1)
+    state = new_state(1)
     world = game.world._replace(masks=np.stack([agent.blocked, agent.blocked]))
     rng = np.random.default_rng(4)
     free = np.argwhere(~agent.blocked)

@@ -34,8 +34,13 @@ def test_batched_cem_trains_the_single_env_trainers_policy(tmp_path, monkeypatch
     assert np.array_equal(single.bias, batched.bias)
     assert np.abs(batched.weights).max() > 0  # it moved away from the zero start
     cfg = compose(
-        ["env=enclosed", "game.t_max=2", "recorder=none", "pursuer=policy",
-         f"pursuer.path={tmp_path / 'batched.npz'}"]
+        [
+            "env=enclosed",
+            "game.t_max=2",
+            "recorder=none",
+            "pursuer=policy",
+            f"pursuer.path={tmp_path / 'batched.npz'}",
+        ]
     )
     result = Game(cfg).play(str(tmp_path)).result
     assert 0.0 <= result["tracking_rate"] <= 1.0

@@ -108,7 +108,9 @@ class _Batch:
             a = a.astype(np.float64)
             live = a[playing]
             if not np.isfinite(live).all():
-                raise ValueError(f"{role} actions must be finite, got {a[playing][~np.isfinite(live).all(1)][0]!r}.")
+                raise ValueError(
+                    f"{role} actions must be finite, got {a[playing][~np.isfinite(live).all(1)][0]!r}."
+                )
             if np.abs(live).max(initial=0.0) > 1.0:
                 if not self.settings.clip_actions:
                     bad = live[(np.abs(live) > 1.0).any(axis=1)][0]
@@ -265,8 +267,8 @@ class SelfPlayVectorEnv(_Batch):
         return (
             self._observations(),
             {"pursuer": rewards, "evader": -rewards},
-            {role: never for role in ROLES},
-            {role: ended for role in ROLES},
+            dict.fromkeys(ROLES, never),
+            dict.fromkeys(ROLES, ended),
             infos,
         )
 
@@ -293,7 +295,9 @@ def vector_env(
         )
     if role == "both":
         if opponent is not None:
-            raise ConfigError("role='both' has no opponent: both agents learn; leave opponent unset.")
+            raise ConfigError(
+                "role='both' has no opponent: both agents learn; leave opponent unset."
+            )
         return SelfPlayVectorEnv(num_envs, config, overrides, **settings)
     cls = PursuitVectorEnv if role == "pursuer" else EvasionVectorEnv
     return cls(num_envs, config, overrides, opponent, **settings)

@@ -19,9 +19,9 @@ decision tick; gives its command       or the kernel reads the opponent's action
 metrics.add(current tick)              kernels.tally
 _integrate: substeps, pursuer then     kernels.move(pursuer), kernels.move(evader), per
 evader (GridSimulator.step)            substep
-step += 1; _sense(): poses, detector,  steps += 1; kernels.sense: kernels.detect, then
-in_view                                kernels.body_in_view
-EnvGame: reward += detection,          kernels.sense (memory), state.rewards
+step += 1; _sense(): poses, detector,  steps += 1; camera.sense: camera.detect, then
+in_view                                camera.body_in_view
+EnvGame: reward += detection,          camera.sense (memory), state.rewards
 features.remember
 =====================================  =====================================================
 
@@ -54,9 +54,19 @@ from pegame.game import STREAMS, Scenario, spawn
 from pegame.navigation import shared_inflation
 from pegame.sims.grid import GridSimulator
 from pegame.vector import kernels
-from pegame.vector.kernels import EVADER, PURSUER, BatchState, Rules, World
+from pegame.vector.features import features
 from pegame.vector.metrics import new_tally, summary
 from pegame.vector.opponents import opponent_for
+from pegame.vector.state import (
+    DETECTED,
+    EVADER,
+    PURSUER,
+    TICKS,
+    BatchState,
+    Rules,
+    World,
+    new_state,
+)
 
 #: the oracle detector's perception fields and the values the kernels play
 PERCEPTION_OFF = {
@@ -105,7 +115,9 @@ class BatchedGame:
         self, cfg: DictConfig, settings: EnvSettings, roles: Sequence[str], num_games: int
     ) -> None:
         if not (isinstance(num_games, (int, np.integer)) and num_games >= 1):
-            raise ConfigError(f"Invalid value for 'num_envs': {num_games!r}. Allowed: a whole number >= 1.")
+            raise ConfigError(
+                f"Invalid value for 'num_envs': {num_games!r}. Allowed: a whole number >= 1."
+            )
         self.settings = settings
         self.roles = tuple(roles)
         self.num_games = int(num_games)
@@ -120,7 +132,7 @@ class BatchedGame:
         }
         self.world = _world(context.grid, context, settings)
         self.rules = _rules(scenario)
-        self.state: BatchState = kernels.new_state(self.num_games)
+        self.state: BatchState = new_state(self.num_games)
         self.state.tally[:] = new_tally()
         self.opponent = (
             opponent_for(scenario, self.roles[0], self.rules.bodies, self.num_games)
@@ -191,9 +203,7 @@ class BatchedGame:
     def observations(self, role: str) -> np.ndarray:
         """Float32 (N, size): ``role``'s observation in every game (a new array)."""
         out = np.empty((self.num_games, self.features[role].size), dtype=np.float32)
-        kernels.features(
-            self.world, self.rules, self.state, out, PURSUER if role == "pursuer" else EVADER
-        )
+        features(self.world, self.rules, self.state, out, PURSUER if role == "pursuer" else EVADER)
         return out
 
     def time(self) -> np.ndarray:
@@ -203,10 +213,8 @@ class BatchedGame:
     def tracking_rate(self) -> np.ndarray:
         """Float64 (N,): the fraction of the ticks played with the evader detected."""
         tally = self.state.tally
-        ticks = tally[:, kernels.TICKS]
-        return np.divide(
-            tally[:, kernels.DETECTED], ticks, out=np.zeros(self.num_games), where=ticks > 0
-        )
+        ticks = tally[:, TICKS]
+        return np.divide(tally[:, DETECTED], ticks, out=np.zeros(self.num_games), where=ticks > 0)
 
     def summary(self, game: int) -> dict:
         """Game ``game``'s measures (``TrackingMetrics.summary``)."""
@@ -220,7 +228,10 @@ def _world(grid, context, settings: EnvSettings) -> World:
     crop = LocalCrop(grid, settings.crop_cells, settings.crop_resolution)
     x0, x1, y0, y1 = grid.extent
     masks = np.stack(
-        [shared_inflation(grid, context.pursuer.radius), shared_inflation(grid, context.evader.radius)]
+        [
+            shared_inflation(grid, context.pursuer.radius),
+            shared_inflation(grid, context.evader.radius),
+        ]
     )
     return World(
         grid.blocked,
@@ -266,4 +277,3 @@ def _rules(scenario: Scenario) -> Rules:
         int(settings.decide_every),
         int(settings.ticks),
     )
-

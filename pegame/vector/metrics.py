@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from pegame.metrics import _rounded
-from pegame.vector import kernels as k
+from pegame.vector import state as k
 
 
 def new_tally() -> np.ndarray:

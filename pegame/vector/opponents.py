@@ -24,7 +24,7 @@ from pegame.errors import ConfigError
 from pegame.evaders.random import RandomEvader
 from pegame.pursuers.random import RandomPursuer
 from pegame.types import Pose
-from pegame.vector.kernels import EVADER, PURSUER, V_MAX, W_MAX
+from pegame.vector.state import EVADER, PURSUER, V_MAX, W_MAX
 
 
 class ActionTable:
@@ -98,4 +98,3 @@ def opponent_for(scenario, learner: str, bodies: np.ndarray, num_games: int):
         "reads the estimator's belief, which the batched game does not compute); play "
         "other pursuers with the single env pegame/Evasion-v0."
     )
-
