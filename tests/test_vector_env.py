@@ -160,6 +160,8 @@ def test_gymnasium_vector_wrappers_run_on_it():
 
 def test_bad_actions_and_unsupported_configs_are_clear_errors():
     env = vector_env(2, overrides=SHORT + ["evader.model=action"], opponent="random")
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.zeros((2, 2), np.float32))
     env.reset(seed=0)
     with pytest.raises(ValueError, match=r"\[-1, 1\]"):
         env.step(np.full((2, 2), 2.0, np.float32))

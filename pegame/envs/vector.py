@@ -59,6 +59,7 @@ class _Batch:
         self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
         self._autoreset = np.zeros(self.num_envs, np.bool_)
         self._all = np.arange(self.num_envs)
+        self._started = False
 
     def _observation_space(self, role: str) -> spaces.Box:
         features = self.game.features[role]
@@ -92,6 +93,7 @@ class _Batch:
         seeds = self._seeds(seed)
         self.game.reset_games(self._all, self._game_seeds(self._all, seeds))
         self._autoreset[:] = False
+        self._started = True
 
     def _commands(self, actions, playing: np.ndarray) -> dict[str, np.ndarray]:
         """role -> (N, 2) (v, w) of the learners' batched ``actions`` (role -> (N, 2) in
@@ -122,9 +124,11 @@ class _Batch:
             out[role] = a * np.array([body.v_max, body.w_max])
         return out
 
-    def _advance(self, actions) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
+    def _advance(self, actions) -> tuple[np.ndarray, np.ndarray, dict]:
         """Step the playing games, reset the ones that ended last step (NEXT_STEP).
-        Returns (rewards, playing, resetting, infos)."""
+        Returns the rewards, the games that ended and the infos."""
+        if not self._started:
+            raise RuntimeError("No games in progress: call reset() before step().")
         resetting = self._autoreset.copy()
         playing = ~resetting
         rewards = self.game.step(playing, self._commands(actions, playing))
@@ -142,8 +146,8 @@ class _Batch:
             self._add_info(infos, {"metrics": self.game.summary(game)}, game)
         if resetting.any():
             self._seed_info(infos, resetting)
-        self._autoreset = ended
-        return rewards, ended, resetting, infos
+        self._autoreset = ended.copy()  # the caller may keep or change what it is given
+        return rewards, ended, infos
 
     def _seed_info(self, infos: dict, games: np.ndarray) -> dict:
         infos["seed"] = np.where(games, self.game.seeds, 0)
@@ -188,13 +192,12 @@ class _LearnerVectorEnv(_Batch, VectorEnv):
 
     def step(self, actions):
         """One decision period of every game ((N, 2) actions; ValueError for a bad one)."""
-        rewards, ended, _, infos = self._advance({self.role: actions})
-        truncations = ended
+        rewards, ended, infos = self._advance({self.role: actions})
         return (
             self.game.observations(self.role),
             self._sign * rewards,
             np.zeros(self.num_envs, np.bool_),
-            truncations,
+            ended,
             infos,
         )
 
@@ -262,7 +265,7 @@ class SelfPlayVectorEnv(_Batch):
         """One decision period of every game with both agents' (N, 2) actions."""
         if not isinstance(actions, dict) or sorted(actions) != sorted(ROLES):
             raise ValueError(f"actions must map each agent in {list(ROLES)} to its (N, 2) actions.")
-        rewards, ended, _, infos = self._advance(actions)
+        rewards, ended, infos = self._advance(actions)
         never = np.zeros(self.num_envs, np.bool_)
         return (
             self._observations(),

@@ -140,7 +140,6 @@ class BatchedGame:
             else None
         )
         self.seeds = np.zeros(self.num_games, np.int64)
-        self._all = np.arange(self.num_games)
 
     @property
     def steps(self) -> int:
