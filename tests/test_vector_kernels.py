@@ -106,3 +106,17 @@ def test_move_is_the_grid_simulators(game, a_max):
         assert tuple(state.poses[0, 0]) == (agent.pose.x, agent.pose.y, agent.pose.theta)
         if agent.limited:
             assert tuple(state.velocities[0, 0]) == (agent.velocity.v, agent.velocity.w)
+
+
+def test_hypot_shortcuts_answer_as_the_exact_hypot():
+    rng = np.random.default_rng(5)
+    res = 0.05
+    pairs = rng.uniform(-0.1, 0.1, (20000, 2)).tolist()
+    # Lengths on the edges: whole numbers of half cells, and the camera's range limits.
+    for length in (0.025, 0.05, 0.075, 0.3, 5.0):
+        angles = rng.uniform(-math.pi, math.pi, 2000)
+        pairs += np.column_stack([length * np.cos(angles), length * np.sin(angles)]).tolist()
+    for x, y in pairs:
+        assert exact.ceil_of_hypot(x, y, res) == math.ceil(2 * math.hypot(x, y) / res)
+        assert exact.hypot_within(x, y, 0.3, 5.0) == (0.3 <= math.hypot(x, y) <= 5.0)
+        assert exact.hypot_within(x, y, 0.025, 0.075) == (0.025 <= math.hypot(x, y) <= 0.075)

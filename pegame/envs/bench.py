@@ -88,6 +88,7 @@ def bench_vector_env(
     overrides: Sequence[str] = ("env=enclosed",),
     seed: int = 0,
     single_steps: int = 300,
+    **settings,
 ) -> dict[str, float | int]:
     """The batched env (:mod:`pegame.envs.vector`) against the single env, in the same run.
 
@@ -100,6 +101,7 @@ def bench_vector_env(
     the smart evader. Resets are not timed (a reset spawns each game in Python: its cost
     per game is ``vector_reset_ms_per_game``). Figures are medians over the rounds;
     ``vector_speedup_per_core`` is the median of the rounds' ratios to the single env.
+    ``settings``: env options (:class:`pegame.envs.settings.EnvSettings`) for both.
     Memory per game: the resident memory the batched env added (its kernels already
     loaded), divided by the games; and the bytes of its arrays per game (state, opponent
     table, one observation).
@@ -112,24 +114,24 @@ def bench_vector_env(
 
     rng = np.random.default_rng(seed)
     threads = numba.config.NUMBA_NUM_THREADS
-    single = parallel_env(overrides=overrides)
+    single = parallel_env(overrides=overrides, **settings)
     single.reset(seed=seed)
     single.step({agent: np.zeros(2, np.float32) for agent in single.possible_agents})
     random_evader = [*overrides, "evader.model=action"]
     # Load the kernels (the parallel ones from PARALLEL_GAMES games on) before measuring.
     size = min(num_envs, PARALLEL_GAMES)
-    warm = vector_env(size, overrides=random_evader, opponent="random")
+    warm = vector_env(size, overrides=random_evader, opponent="random", **settings)
     warm.reset(seed=seed)
     warm.step(np.zeros((size, 2), np.float32))
     before = _rss_bytes()
-    env = vector_env(num_envs, overrides=random_evader, opponent="random")
+    env = vector_env(num_envs, overrides=random_evader, opponent="random", **settings)
     start = time.perf_counter()
     env.reset(seed=seed)
     reset_s = time.perf_counter() - start
     env.step(np.zeros((num_envs, 2), np.float32))
     memory = (_rss_bytes() - before) / num_envs
     arrays = _array_bytes(env) / num_envs
-    smart = vector_env(smart_envs, overrides=overrides, opponent="smart")
+    smart = vector_env(smart_envs, overrides=overrides, opponent="smart", **settings)
     smart.reset(seed=seed)
     smart.step(np.zeros((smart_envs, 2), np.float32))
     per_round = {"single": [], "core": [], "all": [], "smart": []}

@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-from pegame.vector.exact import hypot, wrap_angle
+from pegame.vector.exact import hypot, hypot_within, wrap_angle
 from pegame.vector.state import (
     BODY_HEIGHT,
     BOX_H,
@@ -92,8 +92,7 @@ def point_in_view(world, camera, px, py, ptheta, x, y):
     """:func:`pegame.visibility.in_view` of the map point (x, y) (m) from the camera at
     (px, py, ptheta)."""
     dx, dy = x - px, y - py
-    distance = hypot(dx, dy)
-    if not camera[NEAR] <= distance <= camera[FAR]:
+    if not hypot_within(dx, dy, camera[NEAR], camera[FAR]):
         return False
     if abs(wrap_angle(math.atan2(dy, dx) - ptheta)) > 0.5 * camera[FOV]:
         return False

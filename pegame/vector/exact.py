@@ -15,7 +15,11 @@ compiles for the same expression:
   up to 3 pi, where the remainder is one exact subtraction, Sterbenz's lemma) and falls
   back to Python's floored modulo and one correction beyond.
 
-Both are compared with the Python functions in ``tests/test_vector_kernels.py``.
+:func:`ceil_of_hypot` and :func:`hypot_within` give what a kernel does with the exact
+hypot (a sample count, a range test) from the plain sqrt(x^2 + y^2), and take the exact
+one only when that is within its error bound of the answer's edge: most calls then cost
+a square root. All are compared with the Python functions in
+``tests/test_vector_kernels.py``.
 """
 
 from __future__ import annotations
@@ -102,3 +106,35 @@ def wrap_angle(angle):
         if wrapped > math.pi:
             wrapped -= period
     return math.pi if wrapped == -math.pi else wrapped
+
+
+#: a bound, relative, on |sqrt(x * x + y * y) - hypot(x, y)| (a few ulps, with margin)
+_NAIVE_ERROR = 1e-12
+
+
+@njit(cache=True, inline="always")
+def _margin(value):
+    return _NAIVE_ERROR * (abs(value) + 1.0)
+
+
+@njit(cache=True)
+def ceil_of_hypot(x, y, res):
+    """``math.ceil(2 * hypot(x, y) / res)`` (res > 0) of Python's hypot (the grid
+    simulator's sample count), from the plain sqrt(x * x + y * y) unless a whole number
+    lies within its error bound."""
+    naive = 2 * math.sqrt(x * x + y * y) / res
+    whole = math.ceil(naive)
+    if whole - naive > _margin(naive) and naive - (whole - 1) > _margin(naive):
+        return whole
+    return math.ceil(2 * hypot(x, y) / res)
+
+
+@njit(cache=True)
+def hypot_within(x, y, low, high):
+    """``low <= hypot(x, y) <= high`` of Python's hypot, from the plain sqrt(x * x + y * y)
+    unless it lies within its error bound of low or high."""
+    naive = math.sqrt(x * x + y * y)
+    margin = _margin(naive)
+    if abs(naive - low) > margin and abs(naive - high) > margin:
+        return low <= naive <= high
+    return low <= hypot(x, y) <= high

@@ -24,7 +24,7 @@ from numba import njit, prange
 
 from pegame.sims.grid import _sweep
 from pegame.vector.camera import sense
-from pegame.vector.exact import hypot, wrap_angle
+from pegame.vector.exact import ceil_of_hypot, hypot, wrap_angle
 from pegame.vector.state import (
     A_MAX,
     ALPHA_MAX,
@@ -88,7 +88,7 @@ def move(world, rules, state, game, role, dt):
         dx = radius * (math.sin(theta) - math.sin(theta0))
         dy = -radius * (math.cos(theta) - math.cos(theta0))
     tx, ty = x0 + dx, y0 + dy
-    n = max(1, math.ceil(2 * hypot(tx - x0, ty - y0) / world.frame[5]))
+    n = max(1, ceil_of_hypot(tx - x0, ty - y0, world.frame[5]))
     x, y = _sweep(world.masks[role], x0, y0, tx, ty, n, world.frame)
     pose[0], pose[1], pose[2] = x, y, wrap_angle(theta)
     if limited:
