@@ -27,8 +27,15 @@ features.remember
 
 and ``TickLoop.start`` (spawn, plugin resets, sense tick 0) is :meth:`reset_games`. The
 kernels play every game's tick in one call (:func:`pegame.vector.kernels.play`, parallel
-over games). ``tests/test_vector_env.py`` plays the batched and the single env side by
-side, which keeps the two orders the same.
+over games from ``PARALLEL_GAMES`` games on: below, starting numba's threads costs more
+than it saves). ``tests/test_vector_env.py`` plays the batched and the single env side
+by side, through autoresets and with each opponent, which keeps the two orders the same.
+
+Why a mirror and not the loop itself: ``TickLoop.advance`` drives one game's plugin
+objects with Python values (poses, detections, velocities), and its cost per game is
+what the batch exists to remove; a loop generic over batched plugins would need a
+batched version of every plugin interface. The kernels keep the loop's order instead,
+and the side-by-side test is the contract.
 
 What the batched game plays (anything else is a ConfigError at construction): the grid
 simulator; the oracle detector with its perception parts off (the default; no misses,
