@@ -212,9 +212,10 @@ class PursuitVectorEnv(_LearnerVectorEnv):
 
 
 class EvasionVectorEnv(_LearnerVectorEnv):
-    """The batched ``pegame/Evasion-v0``: the learners are the evaders (the opponent:
-    ``pursuer=random pursuer.model=action``, see :mod:`pegame.vector.opponents`; its
-    games run no estimator, so the metrics' estimation measures are None)."""
+    """The batched ``pegame/Evasion-v0``: the learners are the evaders. A pursuer
+    strategy opponent runs with its estimator per game in Python; the random pursuer
+    with ``model=action`` runs batched and without one, so that its games' estimation
+    measures are None (see :mod:`pegame.vector.opponents`)."""
 
     role = "evader"
 

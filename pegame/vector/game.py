@@ -40,7 +40,8 @@ and the side-by-side test is the contract.
 What the batched game plays (anything else is a ConfigError at construction): the grid
 simulator; the oracle detector with its perception parts off (the default; no misses,
 noise, rate, latency or false positives); ``game.turn_order=simultaneous``; no belief in
-the observation; opponents as :func:`pegame.vector.opponents.opponent_for` allows.
+the observation. A pursuer strategy as the opponent adds the loop's estimation per game
+in Python (:class:`pegame.vector.opponents.PursuerStrategyOpponent`).
 """
 
 from __future__ import annotations
@@ -163,22 +164,23 @@ class BatchedGame:
         position in ``seeds`` (TickLoop.start: spawn, resets, tick 0 sensed)."""
         state, context = self.state, self.context
         games = np.asarray(games, dtype=np.int64)
-        other = None if self.opponent is None else ("pursuer", "evader")[self.opponent.role]
+        opponent = self.opponent
         for game, seed in zip(games.tolist(), seeds):
             streams = dict(zip(STREAMS, np.random.SeedSequence(seed).spawn(len(STREAMS))))
             pursuer, evader = spawn(context, np.random.default_rng(streams["spawn"]))
             self.seeds[game] = seed
             state.poses[game, PURSUER] = (pursuer.x, pursuer.y, pursuer.theta)
             state.poses[game, EVADER] = (evader.x, evader.y, evader.theta)
-            if other is not None:
-                pose = pursuer if other == "pursuer" else evader
-                self.opponent.reset(game, np.random.default_rng(streams[other]), pose)
+            if opponent is not None:
+                opponent.reset(game, streams, pursuer if opponent.role == PURSUER else evader)
         state.velocities[games] = 0.0
         state.commands[games] = 0.0
         state.steps[games] = 0
         state.has_seen[games] = False
         state.tally[games] = new_tally()
         kernels.sense_games(self.world, self.rules, state, games)
+        if opponent is not None:
+            opponent.sensed(state, games, self.context.control_dt)
 
     def step(self, playing: np.ndarray, commands: dict[str, np.ndarray]) -> np.ndarray:
         """One env step (``ticks_per_action`` control ticks) of the games where ``playing``
@@ -204,6 +206,7 @@ class BatchedGame:
                     state, games, steps * rules.control_dt, steps % rules.decide_every == 0
                 )
                 kernels.play(self.world, rules, state, live, 1, _NO_TABLE, -1)
+                opponent.sensed(state, games, rules.control_dt)
         return state.rewards.copy()
 
     def observations(self, role: str) -> np.ndarray:
@@ -223,7 +226,11 @@ class BatchedGame:
         return np.divide(tally[:, DETECTED], ticks, out=np.zeros(self.num_games), where=ticks > 0)
 
     def summary(self, game: int) -> dict:
-        """Game ``game``'s measures (``TrackingMetrics.summary``)."""
+        """Game ``game``'s measures (``TrackingMetrics.summary``): a pursuer strategy's
+        opponent keeps them itself (with the estimator's), else the kernels' tally."""
+        metrics = getattr(self.opponent, "metrics", None)
+        if metrics is not None:
+            return metrics[game].summary()
         return summary(self.state.tally[game], self.context.control_dt)
 
 
