@@ -14,7 +14,7 @@ from pegame.sims.grid import _Agent
 from pegame.types import Pose, Velocity, wrap_angle
 from pegame.vector import camera as batched_camera
 from pegame.vector import exact, kernels
-from pegame.vector.features import crop_into
+from pegame.vector.features import _cells, crop_into
 from pegame.vector.state import new_state
 from pegame.visibility import body_in_view, in_view
 
@@ -61,6 +61,42 @@ def test_crop_is_the_reference_crop(game):
             grid, x, y, theta, settings.crop_cells, settings.crop_resolution
         ).ravel()
         np.testing.assert_array_equal(out, want)
+
+
+def test_crop_on_cell_edges_is_the_reference_crop(game):
+    """Poses whose crop cells fall on map cell edges (headings along the axes, positions on
+    the map's lattice and one ulp off it) take the division route and still give the
+    reference crop; random poses take the multiplication route."""
+    world, grid = game.world, game.context.grid
+    settings = game.settings
+    res, (gx, gy, _) = grid.resolution, grid.origin
+    cells = np.empty(settings.crop_cells**2, np.int64)
+    out = np.empty(settings.crop_cells**2, np.float32)
+    rng = np.random.default_rng(7)
+    height, width = grid.blocked.shape
+    slow = []
+    headings = [0.0, math.pi / 2, math.pi, -math.pi / 2, -0.0, math.nextafter(0.0, 1.0)]
+    for i in range(300):
+        row, col = rng.integers(-5, height + 5), rng.integers(-5, width + 5)
+        x, y = gx + col * res, gy + row * res
+        if i % 3:
+            x = math.nextafter(x, math.inf if i % 3 == 1 else -math.inf)
+        theta = headings[i % len(headings)]
+        slow.append(_cells(world, x, y, theta, cells))
+        crop_into(world, x, y, theta, out, 0)
+        want = local_crop_reference(
+            grid, x, y, theta, settings.crop_cells, settings.crop_resolution
+        ).ravel()
+        np.testing.assert_array_equal(out, want)
+    assert np.mean(slow) > 0.9
+    x0, x1, y0, y1 = grid.extent
+    fast = [
+        not _cells(world, x, y, theta, cells)
+        for x, y, theta in zip(
+            rng.uniform(x0, x1, 100), rng.uniform(y0, y1, 100), rng.uniform(-4, 4, 100)
+        )
+    ]
+    assert np.mean(fast) > 0.9
 
 
 def test_in_view_tests_are_the_visibility_functions(game):

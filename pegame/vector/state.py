@@ -55,6 +55,8 @@ class World(NamedTuple):
     grid inflated by the pursuer's and the evader's radius (the simulator's collision
     masks); pooled, crop_x, crop_y, crop_frame: the crop's pooled map, robot-frame cell
     offsets (m) and its map-to-cell numbers (:class:`pegame.envs.crop.LocalCrop`, float64);
+    crop_values: float32 (1 + H * W,): the crop's value off the map (1.0, blocked), then
+    the pooled map's cells flat (1.0 blocked, 0.0 free), the look-up table of the crop;
     extent: (x0, y0, 2 / width, 2 / height, diagonal) of the observations' normalisation.
     """
 
@@ -65,6 +67,7 @@ class World(NamedTuple):
     crop_x: np.ndarray
     crop_y: np.ndarray
     crop_frame: np.ndarray
+    crop_values: np.ndarray
     extent: np.ndarray
 
 
