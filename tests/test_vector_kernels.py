@@ -14,9 +14,10 @@ from pegame.sims.grid import _Agent
 from pegame.types import Pose, Velocity, wrap_angle
 from pegame.vector import camera as batched_camera
 from pegame.vector import exact, kernels
-from pegame.vector.features import _cells, crop_into
+from pegame.vector.features import crop_into
 from pegame.vector.state import new_state
 from pegame.visibility import body_in_view, in_view
+from pegame.visibility.sight import _segment_clear
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +71,6 @@ def test_crop_on_cell_edges_is_the_reference_crop(game):
     world, grid = game.world, game.context.grid
     settings = game.settings
     res, (gx, gy, _) = grid.resolution, grid.origin
-    cells = np.empty(settings.crop_cells**2, np.int64)
     out = np.empty(settings.crop_cells**2, np.float32)
     rng = np.random.default_rng(7)
     height, width = grid.blocked.shape
@@ -82,8 +82,7 @@ def test_crop_on_cell_edges_is_the_reference_crop(game):
         if i % 3:
             x = math.nextafter(x, math.inf if i % 3 == 1 else -math.inf)
         theta = headings[i % len(headings)]
-        slow.append(_cells(world, x, y, theta, cells))
-        crop_into(world, x, y, theta, out, 0)
+        slow.append(crop_into(world, x, y, theta, out, 0))
         want = local_crop_reference(
             grid, x, y, theta, settings.crop_cells, settings.crop_resolution
         ).ravel()
@@ -91,7 +90,7 @@ def test_crop_on_cell_edges_is_the_reference_crop(game):
     assert np.mean(slow) > 0.9
     x0, x1, y0, y1 = grid.extent
     fast = [
-        not _cells(world, x, y, theta, cells)
+        not crop_into(world, x, y, theta, out, 0)
         for x, y, theta in zip(
             rng.uniform(x0, x1, 100), rng.uniform(y0, y1, 100), rng.uniform(-4, 4, 100)
         )
@@ -118,6 +117,27 @@ def test_in_view_tests_are_the_visibility_functions(game):
         assert body == body_in_view(grid, camera, pose, (ex, ey), 0.25)
         seen += centre
     assert 100 < seen < 2900  # both outcomes were tested
+
+
+def test_segment_clear_on_cell_edges_is_the_sight_kernel(game):
+    """Segments along the map's lattice lines (their samples on cell edges: the division
+    route) and random ones (the product route) give _segment_clear's answer."""
+    world, grid = game.world, game.context.grid
+    res, (gx, gy, _) = grid.resolution, grid.origin
+    height, width = grid.blocked.shape
+    rng = np.random.default_rng(8)
+    clear = []
+    for i in range(2000):
+        (r, c), (r2, c2) = rng.integers(-3, [height + 3, width + 3], (2, 2))
+        if i % 2:
+            r2 = r  # along a lattice line
+        ax, ay, bx, by = gx + c * res, gy + r * res, gx + c2 * res, gy + r2 * res
+        if i % 4 == 3:
+            ax, ay = ax + rng.uniform(0, res), ay + rng.uniform(0, res)
+        want = _segment_clear(grid.blocked, ax, ay, bx, by, 0.5 * res, grid.kernel_frame)
+        assert batched_camera.segment_clear(world, ax, ay, bx, by, 0.5 * res) == want
+        clear.append(want)
+    assert 0.05 < np.mean(clear) < 0.95  # both outcomes were tested
 
 
 @pytest.mark.parametrize("a_max", [math.inf, 0.8])

@@ -23,7 +23,13 @@ import math
 import numpy as np
 from numba import njit
 
-from pegame.vector.exact import hypot, hypot_within, wrap_angle
+from pegame.vector.exact import (
+    cell_by_division,
+    cell_by_product,
+    hypot,
+    hypot_within,
+    wrap_angle,
+)
 from pegame.vector.state import (
     BODY_HEIGHT,
     BOX_H,
@@ -53,16 +59,40 @@ _SILHOUETTE = np.array(SILHOUETTE)
 _CHUNK = 32
 
 
+@njit(cache=True, inline="always")
+def _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, rotated):
+    """The cells (1 + flat index, 0 off the grid) of samples start..start + size - 1 of
+    the segment into ``cells`` by :func:`pegame.vector.exact.cell_by_product`; returns
+    whether all are decided. Inlined with ``rotated`` a constant (no branch in the loop).
+    """
+    frame = world.frame
+    height, width = world.blocked.shape
+    ox, oy, gc, gs = frame[0], frame[1], frame[2], frame[3]
+    inverse, dt = 1.0 / frame[5], 1.0 / count
+    decided = True
+    for j in range(size):
+        k = start + j
+        t = 1.0 if k == count else k * dt
+        u = ax + t * dx - ox
+        v = ay + t * dy - oy
+        if rotated:
+            u, v = gc * u + gs * v, -gs * u + gc * v
+        cells[j], ok = cell_by_product(u, v, inverse, height, width)
+        decided &= ok
+    return decided
+
+
 @njit(cache=True)
 def segment_clear(world, ax, ay, bx, by, step):
     """:func:`pegame.visibility.sight._segment_clear` on the grid: True when no sample of
     the segment from (ax, ay) to (bx, by) (m), ``step`` m apart, lies in a blocked or
     off-grid cell. The same samples and cells (the tests compare the two), found
-    _CHUNK at a time in a loop that LLVM vectorises, then looked up; the test stops at
-    the first chunk with a blocked cell."""
-    frame, blocked = world.frame, world.blocked
-    height, width = blocked.shape
-    flat = blocked.ravel()
+    _CHUNK at a time from products (:func:`pegame.vector.exact.cell_by_product`; a chunk
+    with a sample near a cell edge is found again by the division), then looked up in
+    world.sight_values (entry 0: off the grid, blocked); the test stops at the first
+    chunk with a blocked cell."""
+    frame, values = world.frame, world.sight_values
+    height, width = world.blocked.shape
     ox, oy, gc, gs, rotated, res = frame[0], frame[1], frame[2], frame[3], frame[4] != 0.0, frame[5]
     count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
     dx, dy = bx - ax, by - ay
@@ -70,19 +100,21 @@ def segment_clear(world, ax, ay, bx, by, step):
     cells = np.empty(_CHUNK, np.int64)
     for start in range(0, count + 1, _CHUNK):
         size = min(_CHUNK, count + 1 - start)
+        if rotated:
+            decided = _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, True)
+        else:
+            decided = _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, False)
+        if not decided:
+            for j in range(size):
+                k = start + j
+                t = 1.0 if k == count else k * dt
+                u = ax + t * dx - ox
+                v = ay + t * dy - oy
+                if rotated:
+                    u, v = gc * u + gs * v, -gs * u + gc * v
+                cells[j] = cell_by_division(u, v, res, height, width)
         for j in range(size):
-            k = start + j
-            t = 1.0 if k == count else k * dt
-            u = ax + t * dx - ox
-            v = ay + t * dy - oy
-            if rotated:
-                u, v = gc * u + gs * v, -gs * u + gc * v
-            qc, qr = u / res, v / res
-            inside = (qr >= 0.0) & (qr < height) & (qc >= 0.0) & (qc < width)
-            cells[j] = np.int64(qr) * width + np.int64(qc) if inside else -1
-        for j in range(size):
-            cell = cells[j]
-            if cell < 0 or flat[cell]:
+            if values[cells[j]]:
                 return False
     return True
 

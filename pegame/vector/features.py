@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit, prange
 
 from pegame.envs.observations import AGE_SCALE
-from pegame.vector.exact import hypot, wrap_angle
+from pegame.vector.exact import cell_by_division, cell_by_product, hypot, wrap_angle
 from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER
 
 
@@ -34,83 +34,60 @@ def _pose_features(world, x, y, theta, out, at):
     out[at + 3] = math.sin(theta)
 
 
-#: |quotient| (cells) below which the multiplied quotient decides the cell (see _cells)
-_QUOTIENT_LIMIT = 2.0**20
-#: distance (cells) from a cell edge beyond which the multiplied quotient decides it
-_EDGE_MARGIN = 2.0**-20
-
-
-@njit(cache=True)
-def _cells(world, x, y, theta, cells):
-    """Every crop cell's flat index in world.crop_values (0: off the map, else 1 + the
-    pooled map's flat index) for the pose (x m, y m, theta rad) into ``cells`` (int64);
-    returns whether the slow route was needed.
-
-    The cell of a map-frame offset d is floor(d / res), the division of
-    :func:`pegame.envs.crop._crop`. The fast route multiplies by 1 / res instead, which
-    picks the same cell whenever no cell edge lies between the two quotients: with
-    u = 2**-53, fl(1 / res) and the product each err by at most u relatively and the
-    division by u, so the two quotients differ by at most 3.01 u |q|, below 4e-10 cells
-    for |q| < 2**20. A product q whose distance to the nearest whole number,
-    | |q - trunc(q)| - 1/2 | away from 1/2 (exact for |q| < 2**20 but for 2**-55), is more
-    than 2**-20 therefore lies in the same cell as the division's quotient, and the
-    tests 0 <= q < n (whole n) agree, so truncation is the floor where they pass. When
-    any cell of the crop misses that test (a pose on a cell edge, far off the map, not
-    finite), the whole crop is computed again with the division. The fast route also
-    rotates by the grid's yaw when it is 0 (gc = 1, gs = 0: the same offsets but for the
-    sign of a zero, which is the same cell), so that its loop has no branch.
-    ``tests/test_vector_kernels.py`` compares the crop with the reference on random
-    poses and on poses whose cells lie on cell edges (the slow route).
-    """
+@njit(cache=True, inline="always")
+def _fast_cells(world, x, y, c, s, cells, rotate):
+    """Every crop cell's flat index in world.crop_values by
+    :func:`pegame.vector.exact.cell_by_product` into ``cells``; returns whether all are
+    decided. Inlined with ``rotate`` a constant, so that each loop has no branch."""
     height, width = world.pooled.shape
     off_x, off_y = world.crop_x, world.crop_y
-    c, s = math.cos(theta), math.sin(theta)
     gx, gy, gc, gs = (
         world.crop_frame[0],
         world.crop_frame[1],
         world.crop_frame[2],
         world.crop_frame[3],
     )
-    rotate, res = world.crop_frame[4] != 0.0, world.crop_frame[5]
-    inverse, near = 1.0 / res, 0.5 - _EDGE_MARGIN
+    inverse = 1.0 / world.crop_frame[5]
     decided = True
-    for k in range(off_x.size):
-        dx = x + (c * off_x[k] - s * off_y[k]) - gx
-        dy = y + (s * off_x[k] + c * off_y[k]) - gy
-        dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
-        qc, qr = dx * inverse, dy * inverse
-        col, row = np.int64(qc), np.int64(qr)
-        decided &= (
-            (abs(abs(qc - col) - 0.5) < near)
-            & (abs(abs(qr - row) - 0.5) < near)
-            & (max(abs(qc), abs(qr)) < _QUOTIENT_LIMIT)
-        )
-        inside = (qr >= 0.0) & (qr < height) & (qc >= 0.0) & (qc < width)
-        cells[k] = row * width + col + 1 if inside else 0
-    if decided:
-        return False
     for k in range(off_x.size):
         dx = x + (c * off_x[k] - s * off_y[k]) - gx
         dy = y + (s * off_x[k] + c * off_y[k]) - gy
         if rotate:
             dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
-        qc, qr = dx / res, dy / res
-        # a quotient in [0, n) is a cell floor(q) in [0, n), and there truncation floors
-        inside = (qr >= 0.0) & (qr < height) & (qc >= 0.0) & (qc < width)
-        cells[k] = np.int64(qr) * width + np.int64(qc) + 1 if inside else 0
-    return True
+        cells[k], ok = cell_by_product(dx, dy, inverse, height, width)
+        decided &= ok
+    return decided
 
 
 @njit(cache=True)
 def crop_into(world, x, y, theta, out, at):
-    """The crop of :class:`pegame.envs.crop.LocalCrop` around (x, y, theta) into
-    out[at:], the cells :func:`pegame.envs.crop._crop` picks (:func:`_cells`), then the
-    look-ups in world.crop_values, whose first entry (off the map) is blocked."""
+    """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
+    rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (same float
+    operations) looked up in world.crop_values (entry 0: off the map, blocked). The
+    cells come from products (:func:`pegame.vector.exact.cell_by_product`), and from the
+    division when any of them is not decided (a pose on cell edges). Returns whether the
+    division was needed. ``tests/test_vector_kernels.py`` compares the crop with the
+    reference on random poses and on poses whose cells lie on cell edges."""
+    c, s = math.cos(theta), math.sin(theta)
     cells = np.empty(world.crop_x.size, np.int64)
-    _cells(world, x, y, theta, cells)
+    if world.crop_frame[4] != 0.0:
+        decided = _fast_cells(world, x, y, c, s, cells, True)
+    else:
+        decided = _fast_cells(world, x, y, c, s, cells, False)
+    if not decided:
+        height, width = world.pooled.shape
+        off_x, off_y, frame = world.crop_x, world.crop_y, world.crop_frame
+        gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
+        for k in range(off_x.size):
+            dx = x + (c * off_x[k] - s * off_y[k]) - gx
+            dy = y + (s * off_x[k] + c * off_y[k]) - gy
+            if frame[4] != 0.0:
+                dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
+            cells[k] = cell_by_division(dx, dy, res, height, width)
     values = world.crop_values
     for k in range(cells.size):
         out[at + k] = values[cells[k]]
+    return not decided
 
 
 @njit(cache=True)

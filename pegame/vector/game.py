@@ -255,6 +255,7 @@ def _world(grid, context, settings: EnvSettings) -> World:
         crop._off_y,
         np.array(crop._origin, dtype=np.float64),
         np.concatenate([[1.0], crop._pooled.ravel()]).astype(np.float32),
+        np.concatenate([[True], grid.blocked.ravel()]),
         np.array([x0, y0, 2.0 / (x1 - x0), 2.0 / (y1 - y0), math.hypot(x1 - x0, y1 - y0)]),
     )
 

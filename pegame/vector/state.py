@@ -57,6 +57,8 @@ class World(NamedTuple):
     offsets (m) and its map-to-cell numbers (:class:`pegame.envs.crop.LocalCrop`, float64);
     crop_values: float32 (1 + H * W,): the crop's value off the map (1.0, blocked), then
     the pooled map's cells flat (1.0 blocked, 0.0 free), the look-up table of the crop;
+    sight_values: bool (1 + H * W,): True (off the grid), then ``blocked`` flat, the
+    line of sight's look-up table;
     extent: (x0, y0, 2 / width, 2 / height, diagonal) of the observations' normalisation.
     """
 
@@ -68,6 +70,7 @@ class World(NamedTuple):
     crop_y: np.ndarray
     crop_frame: np.ndarray
     crop_values: np.ndarray
+    sight_values: np.ndarray
     extent: np.ndarray
 
 
