@@ -10,7 +10,12 @@ from gymnasium.vector import SyncVectorEnv
 
 from pegame.envs.parallel import parallel_env
 from pegame.envs.single import EvasionEnv, PursuitEnv
-from pegame.envs.vector import SelfPlayVectorEnv, vector_env
+from pegame.envs.vector import (
+    EvasionVectorEnv,
+    PursuitVectorEnv,
+    SelfPlayVectorEnv,
+    vector_env,
+)
 from pegame.errors import ConfigError
 
 #: short games on a paper map; a few steps more than one game, to cross an autoreset
@@ -168,6 +173,19 @@ def test_gymnasium_vector_wrappers_run_on_it():
             episodes += int(infos["_episode"].sum())
             assert (infos["episode"]["l"][infos["_episode"]] == 20).all()
     assert episodes == 4
+
+
+def test_make_vec_builds_the_batched_env():
+    """gymnasium.make_vec uses the registered vector_entry_point: the batched env, which
+    plays the games of its "sync" mode (SyncVectorEnv of the single env)."""
+    kwargs = {"overrides": SHORT + ["evader.model=action"], "opponent": "random"}
+    batched = gymnasium.make_vec("pegame/Pursuit-v0", num_envs=3, **kwargs)
+    synced = gymnasium.make_vec(
+        "pegame/Pursuit-v0", num_envs=3, vectorization_mode="sync", **kwargs
+    )
+    assert isinstance(batched, PursuitVectorEnv) and isinstance(synced, SyncVectorEnv)
+    assert isinstance(gymnasium.make_vec("pegame/Evasion-v0", num_envs=2), EvasionVectorEnv)
+    assert play_side_by_side(batched, synced, 5, 25, np.random.default_rng(9)) == 3
 
 
 def test_bad_actions_and_unsupported_configs_are_clear_errors():
