@@ -54,10 +54,11 @@ def test_crop_is_the_reference_crop(game):
     rng = np.random.default_rng(2)
     x0, x1, y0, y1 = grid.extent
     out = np.empty(settings.crop_cells**2, np.float32)
+    cells = np.empty(settings.crop_cells**2, np.int64)
     for x, y, theta in zip(
         rng.uniform(x0 - 2, x1 + 2, 200), rng.uniform(y0 - 2, y1 + 2, 200), rng.uniform(-4, 4, 200)
     ):
-        crop_into(world, x, y, theta, out, 0)
+        crop_into(world, x, y, theta, out, 0, cells)
         want = local_crop_reference(
             grid, x, y, theta, settings.crop_cells, settings.crop_resolution
         ).ravel()
@@ -72,6 +73,7 @@ def test_crop_on_cell_edges_is_the_reference_crop(game):
     settings = game.settings
     res, (gx, gy, _) = grid.resolution, grid.origin
     out = np.empty(settings.crop_cells**2, np.float32)
+    cells = np.empty(settings.crop_cells**2, np.int64)
     rng = np.random.default_rng(7)
     height, width = grid.blocked.shape
     slow = []
@@ -82,7 +84,7 @@ def test_crop_on_cell_edges_is_the_reference_crop(game):
         if i % 3:
             x = math.nextafter(x, math.inf if i % 3 == 1 else -math.inf)
         theta = headings[i % len(headings)]
-        slow.append(crop_into(world, x, y, theta, out, 0))
+        slow.append(crop_into(world, x, y, theta, out, 0, cells))
         want = local_crop_reference(
             grid, x, y, theta, settings.crop_cells, settings.crop_resolution
         ).ravel()
@@ -90,7 +92,7 @@ def test_crop_on_cell_edges_is_the_reference_crop(game):
     assert np.mean(slow) > 0.9
     x0, x1, y0, y1 = grid.extent
     fast = [
-        not crop_into(world, x, y, theta, out, 0)
+        not crop_into(world, x, y, theta, out, 0, cells)
         for x, y, theta in zip(
             rng.uniform(x0, x1, 100), rng.uniform(y0, y1, 100), rng.uniform(-4, 4, 100)
         )

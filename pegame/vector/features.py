@@ -60,16 +60,16 @@ def _fast_cells(world, x, y, c, s, cells, rotate):
 
 
 @njit(cache=True)
-def crop_into(world, x, y, theta, out, at):
+def crop_into(world, x, y, theta, out, at, cells):
     """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
     rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (same float
-    operations) looked up in world.crop_values (entry 0: off the map, blocked). The
+    operations; ``cells``: int64 scratch of the crop's size) looked up in
+    world.crop_values (entry 0: off the map, blocked). The
     cells come from products (:func:`pegame.vector.exact.cell_by_product`), and from the
     division when any of them is not decided (a pose on cell edges). Returns whether the
     division was needed. ``tests/test_vector_kernels.py`` compares the crop with the
     reference on random poses and on poses whose cells lie on cell edges."""
     c, s = math.cos(theta), math.sin(theta)
-    cells = np.empty(world.crop_x.size, np.int64)
     if world.crop_frame[4] != 0.0:
         decided = _fast_cells(world, x, y, c, s, cells, True)
     else:
@@ -91,7 +91,7 @@ def crop_into(world, x, y, theta, out, at):
 
 
 @njit(cache=True)
-def _pursuer_row(world, rules, state, game, row):
+def _pursuer_row(world, rules, state, game, row, cells):
     """``PursuerFeatures.build`` (no belief part) of ``game`` into ``row``."""
     far = rules.camera[FAR]
     px, py, ptheta = state.poses[game, PURSUER]
@@ -104,11 +104,11 @@ def _pursuer_row(world, rules, state, game, row):
         row[5] = min(1.0, hypot(dx, dy) / far)
         row[6] = wrap_angle(math.atan2(dy, dx) - ptheta) / math.pi
         row[7] = min(1.0, (state.steps[game] * rules.control_dt - state.seen[game, 0]) / AGE_SCALE)
-    crop_into(world, px, py, ptheta, row, 8)
+    crop_into(world, px, py, ptheta, row, 8, cells)
 
 
 @njit(cache=True)
-def _evader_row(world, rules, state, game, row):
+def _evader_row(world, rules, state, game, row, cells):
     """``EvaderFeatures.build`` of ``game`` into ``row``."""
     diagonal = world.extent[4]
     ex, ey, etheta = state.poses[game, EVADER]
@@ -121,25 +121,34 @@ def _evader_row(world, rules, state, game, row):
     row[9] = _unit((-s * dx + c * dy) / diagonal)
     row[10] = math.cos(ptheta - etheta)
     row[11] = math.sin(ptheta - etheta)
-    crop_into(world, ex, ey, etheta, row, 12)
+    crop_into(world, ex, ey, etheta, row, 12, cells)
+
+
+#: games per block of the features' loop: one crop scratch array per block, since an
+#: allocation per game costs about as much as the crop's arithmetic
+_BLOCK = 64
+
+
+@njit(cache=True)
+def _features_block(world, rules, state, out, pursuer, block):
+    cells = np.empty(world.crop_x.size, np.int64)
+    for game in range(block * _BLOCK, min(out.shape[0], (block + 1) * _BLOCK)):
+        if pursuer:
+            _pursuer_row(world, rules, state, game, out[game], cells)
+        else:
+            _evader_row(world, rules, state, game, out[game], cells)
 
 
 @njit(cache=True)
 def _features_serial(world, rules, state, out, pursuer):
-    for game in range(out.shape[0]):
-        if pursuer:
-            _pursuer_row(world, rules, state, game, out[game])
-        else:
-            _evader_row(world, rules, state, game, out[game])
+    for block in range(-(-out.shape[0] // _BLOCK)):
+        _features_block(world, rules, state, out, pursuer, block)
 
 
 @njit(cache=True, parallel=True)
 def _features_parallel(world, rules, state, out, pursuer):
-    for game in prange(out.shape[0]):
-        if pursuer:
-            _pursuer_row(world, rules, state, game, out[game])
-        else:
-            _evader_row(world, rules, state, game, out[game])
+    for block in prange(-(-out.shape[0] // _BLOCK)):
+        _features_block(world, rules, state, out, pursuer, block)
 
 
 def features(world, rules, state, out, role):
