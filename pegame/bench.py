@@ -287,6 +287,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         args.map_sizes or quick_sizes, repeat=max(5, repeat // 10), game=not args.quick
     )
     report["env_steps_per_s"] = env_steps_per_second(2 if args.quick else 10)
+    from pegame.envs.bench import vector_env_figures  # the env packages load on first use
+
+    report.update(vector_env_figures(args.quick))
     report.update(plugin_figures(args.quick))
     report["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
@@ -330,6 +333,9 @@ def format_report(report: dict[str, Any]) -> str:
         f"{fmt(report['rrd_mb_per_game'])} MB per 90 s game"
     )
     lines.append(f"env steps/s (PettingZoo, random actions): {fmt(report['env_steps_per_s'])}")
+    from pegame.envs.bench import format_vector
+
+    lines.append(format_vector(report))
     lines.append(
         f"pybullet S-S real-time factor: {fmt(report['pybullet_rtf'])}; vision vs segmentation: "
         f"precision {fmt(report['vision_precision'])}, recall {fmt(report['vision_recall'])}"

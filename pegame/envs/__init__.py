@@ -5,6 +5,9 @@
 - ``gymnasium.make("pegame/Pursuit-v0")`` and ``"pegame/Evasion-v0"`` - one learner
   against a pegame strategy (:mod:`pegame.envs.single`), registered when this package is
   imported (or ``gymnasium.make("pegame.envs:pegame/Pursuit-v0")``);
+- :func:`vector_env` - ``num_envs`` games stepped together by numba kernels, a
+  ``gymnasium.vector.VectorEnv`` for a learning pursuer or evader, or both for self-play
+  (:mod:`pegame.envs.vector`);
 - :func:`bench_steps_per_second` - the env's speed, for ``python -m pegame.bench``.
 
 Every env takes the app's config (``config=`` a composed DictConfig, or ``overrides=``
@@ -29,6 +32,10 @@ _LAZY = {
     "EvasionEnv": "pegame.envs.single",
     "register_envs": "pegame.envs.single",
     "bench_steps_per_second": "pegame.envs.bench",
+    "vector_env": "pegame.envs.vector",
+    "PursuitVectorEnv": "pegame.envs.vector",
+    "EvasionVectorEnv": "pegame.envs.vector",
+    "SelfPlayVectorEnv": "pegame.envs.vector",
 }
 
 __all__ = sorted(_LAZY)

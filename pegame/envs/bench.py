@@ -1,13 +1,15 @@
-"""The environments' speed: steps per second of the PettingZoo env with random actions."""
+"""The environments' speed: steps per second of the PettingZoo env with random actions,
+and of the batched env against it in the same run. The env packages are imported on
+first use, so that ``python -m pegame.bench`` formats its report without them."""
 
 from __future__ import annotations
 
+import os
+import statistics
 import time
 from collections.abc import Sequence
 
 import numpy as np
-
-from pegame.envs.parallel import parallel_env
 
 
 def bench_steps_per_second(
@@ -20,6 +22,8 @@ def bench_steps_per_second(
     (mean reset time: spawn and plugin resets) and ``steps_per_s_with_resets``. The first
     reset and step (numba compilation or cache loading) are not timed.
     """
+    from pegame.envs.parallel import parallel_env
+
     env = parallel_env(overrides=overrides, **settings)
     rng = np.random.default_rng(seed)
     env.reset(seed=seed)
@@ -45,3 +49,152 @@ def bench_steps_per_second(
         "reset_ms": 1e3 * resetting / resets,
         "steps_per_s_with_resets": steps / (stepping + resetting),
     }
+
+
+def _rss_bytes() -> int:
+    """This process's resident memory (bytes; Linux /proc, else 0)."""
+    try:
+        with open("/proc/self/statm") as statm:
+            return int(statm.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError):
+        return 0
+
+
+def _array_bytes(env) -> int:
+    """Bytes of a batched env's arrays: its games' state, the opponent's action table and
+    one batch of observations."""
+    game = env.game
+    table = getattr(game.opponent, "table", None)
+    observation = game.num_games * game.features[env.role].size * 4
+    return sum(a.nbytes for a in game.state) + (0 if table is None else table.nbytes) + observation
+
+
+def _vector_steps_per_second(env, actions: np.ndarray, threads: int) -> float:
+    """Env steps (games x batched steps) per second of ``env`` over the batched
+    ``actions`` (steps, N, 2), on ``threads`` numba threads, no game ending on the way."""
+    import numba
+
+    numba.set_num_threads(threads)
+    start = time.perf_counter()
+    for batch in actions:
+        env.step(batch)
+    return actions.shape[0] * env.num_envs / (time.perf_counter() - start)
+
+
+def bench_vector_env(
+    seconds: float = 20.0,
+    num_envs: int = 4096,
+    smart_envs: int = 256,
+    overrides: Sequence[str] = ("env=enclosed",),
+    seed: int = 0,
+    single_steps: int = 300,
+    **settings,
+) -> dict[str, float | int]:
+    """The batched env (:mod:`pegame.envs.vector`) against the single env, in the same run.
+
+    Rounds alternate (so that the machine's other load hits all alike): the two-agent
+    single env's steps with random actions (``single_steps`` of them, as
+    :func:`bench_steps_per_second`), the
+    batched pursuer env of ``num_envs`` games against the random evader with
+    ``model=action`` on one numba thread (the per-core figure, as NUMBA_NUM_THREADS=1)
+    and on all of numba's threads, and the batched env of ``smart_envs`` games against
+    the smart evader. Resets are not timed (a reset spawns each game in Python: its cost
+    per game is ``vector_reset_ms_per_game``). Figures are medians over the rounds;
+    ``vector_speedup_per_core`` is the median of the rounds' ratios to the single env.
+    ``settings``: env options (:class:`pegame.envs.settings.EnvSettings`) for both.
+    Memory per game: the resident memory the batched env added (its kernels already
+    loaded), divided by the games; and the bytes of its arrays per game (state, opponent
+    table, one observation).
+    """
+    import numba
+
+    from pegame.envs.parallel import parallel_env
+    from pegame.envs.vector import vector_env
+    from pegame.vector.state import PARALLEL_GAMES
+
+    rng = np.random.default_rng(seed)
+    threads = numba.config.NUMBA_NUM_THREADS
+    single = parallel_env(overrides=overrides, **settings)
+    single.reset(seed=seed)
+    single.step({agent: np.zeros(2, np.float32) for agent in single.possible_agents})
+    random_evader = [*overrides, "evader.model=action"]
+    # Load the kernels (the parallel ones from PARALLEL_GAMES games on) before measuring.
+    size = min(num_envs, PARALLEL_GAMES)
+    warm = vector_env(size, overrides=random_evader, opponent="random", **settings)
+    warm.reset(seed=seed)
+    warm.step(np.zeros((size, 2), np.float32))
+    before = _rss_bytes()
+    env = vector_env(num_envs, overrides=random_evader, opponent="random", **settings)
+    start = time.perf_counter()
+    env.reset(seed=seed)
+    reset_s = time.perf_counter() - start
+    env.step(np.zeros((num_envs, 2), np.float32))
+    memory = (_rss_bytes() - before) / num_envs
+    arrays = _array_bytes(env) / num_envs
+    smart = vector_env(smart_envs, overrides=overrides, opponent="smart", **settings)
+    smart.reset(seed=seed)
+    smart.step(np.zeros((smart_envs, 2), np.float32))
+    per_round = {"single": [], "core": [], "all": [], "smart": []}
+    batch = 4
+    played = 1
+    deadline = time.perf_counter() + seconds
+    while time.perf_counter() < deadline and played + 3 * batch < env.game.steps:
+        single.reset(seed=seed + played)
+        pairs = rng.uniform(-1.0, 1.0, (single_steps, 2, 2)).astype(np.float32)
+        start = time.perf_counter()
+        for pair in pairs:
+            single.step({"pursuer": pair[0], "evader": pair[1]})
+        per_round["single"].append(len(pairs) / (time.perf_counter() - start))
+        actions = rng.uniform(-1.0, 1.0, (batch, num_envs, 2)).astype(np.float32)
+        per_round["core"].append(_vector_steps_per_second(env, actions, 1))
+        per_round["all"].append(_vector_steps_per_second(env, actions, threads))
+        actions = rng.uniform(-1.0, 1.0, (batch, smart_envs, 2)).astype(np.float32)
+        per_round["smart"].append(_vector_steps_per_second(smart, actions, 1))
+        played += 3 * batch
+    numba.set_num_threads(threads)
+    single.close()
+    median = {key: statistics.median(values) for key, values in per_round.items()}
+    ratios = [v / s for v, s in zip(per_round["core"], per_round["single"])]
+    return {
+        "num_envs": num_envs,
+        "numba_threads": threads,
+        "rounds": len(ratios),
+        "single_env_steps_per_s": median["single"],
+        "vector_env_steps_per_s": median["core"],
+        "vector_env_steps_per_s_all_cores": median["all"],
+        "vector_speedup_per_core": statistics.median(ratios),
+        "vector_reset_ms_per_game": 1e3 * reset_s / num_envs,
+        "vector_env_bytes_per_game": memory,
+        "vector_env_array_bytes_per_game": arrays,
+        "num_envs_smart": smart_envs,
+        "vector_env_steps_per_s_smart": median["smart"],
+        "smart_opponent_us_per_game_step": 1e6 / median["smart"] - 1e6 / median["core"],
+    }
+
+
+def vector_env_figures(quick: bool) -> dict:
+    """:func:`bench_vector_env` for ``python -m pegame.bench`` (``quick``: 1024 games,
+    5 s); empty without gymnasium."""
+    try:
+        import gymnasium  # noqa: F401
+    except ImportError:
+        return {}
+    return bench_vector_env(seconds=5.0 if quick else 20.0, num_envs=1024 if quick else 4096)
+
+
+def format_vector(report: dict) -> str:
+    """The batched env's line of ``python -m pegame.bench``'s text report."""
+    if report.get("vector_env_steps_per_s") is None:
+        return "batched env: -"
+    r = report
+    return (
+        f"batched env ({r['num_envs']} games, random evader): {r['vector_env_steps_per_s']:.0f} "
+        f"steps/s on one core ({r['vector_speedup_per_core']:.1f}x the single env's "
+        f"{r['single_env_steps_per_s']:.0f} in the same rounds), "
+        f"{r['vector_env_steps_per_s_all_cores']:.0f} on {r['numba_threads']} threads; "
+        f"{r['vector_env_bytes_per_game'] / 1024:.1f} KiB per game "
+        f"({r['vector_env_array_bytes_per_game'] / 1024:.1f} KiB of arrays), reset "
+        f"{r['vector_reset_ms_per_game']:.2f} ms per game; smart evader "
+        f"({r['num_envs_smart']} games): {r['vector_env_steps_per_s_smart']:.0f} steps/s, "
+        f"+{r['smart_opponent_us_per_game_step']:.1f} us per game step"
+    )

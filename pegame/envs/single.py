@@ -86,7 +86,15 @@ class EvasionEnv(_SingleAgentEnv):
 
 def register_envs() -> None:
     """Register ``pegame/Pursuit-v0`` and ``pegame/Evasion-v0`` with Gymnasium (idempotent;
-    importing :mod:`pegame.envs` does it)."""
-    for env_id, cls in ((PURSUIT_ID, PursuitEnv), (EVASION_ID, EvasionEnv)):
+    importing :mod:`pegame.envs` does it), with the batched envs of
+    :mod:`pegame.envs.vector` as their ``vector_entry_point`` (``gymnasium.make_vec``)."""
+    for env_id, cls, batched in (
+        (PURSUIT_ID, PursuitEnv, "PursuitVectorEnv"),
+        (EVASION_ID, EvasionEnv, "EvasionVectorEnv"),
+    ):
         if env_id not in gymnasium.registry:
-            gymnasium.register(id=env_id, entry_point=f"{cls.__module__}:{cls.__name__}")
+            gymnasium.register(
+                id=env_id,
+                entry_point=f"{cls.__module__}:{cls.__name__}",
+                vector_entry_point=f"pegame.envs.vector:{batched}",
+            )

@@ -1,0 +1,316 @@
+"""Batched environments: ``num_envs`` games stepped in one call by numba kernels
+(:mod:`pegame.vector`).
+
+- :class:`PursuitVectorEnv` and :class:`EvasionVectorEnv`: ``gymnasium.vector.VectorEnv``
+  for a learning pursuer (evader) against a scripted opponent, the batched
+  ``pegame/Pursuit-v0`` (``pegame/Evasion-v0``);
+- :class:`SelfPlayVectorEnv`: both roles learning, the batched PettingZoo env
+  (:mod:`pegame.envs.parallel`), with dicts of batched arrays per agent;
+- :func:`vector_env` builds any of them.
+
+Every sub-env is the single env: the spaces are its spaces batched (``single_*_space``
+are the single env's), and the rewards, the end of a game (a truncation after
+``game.t_max`` s), the observations and the infos (``seed`` at a reset; ``time`` and
+``tracking_rate`` after a step; ``metrics`` at the end of a game) are the ones
+``gymnasium.vector.SyncVectorEnv`` of the single envs gives with the same seeds
+(``reset(seed=s)`` seeds game i with s + i; later games draw their seeds from each
+game's generator, as the single env does). Autoreset is Gymnasium's default
+``AutoresetMode.NEXT_STEP``: the step after a game's last returns the first observation
+of its next game (reward 0, actions ignored). All games have the same length, so they
+end and restart together when started together.
+
+What differs from the single env: the batched game plays the configurations that
+:func:`pegame.vector.game.check_playable` allows, and its means and path lengths are
+summed tick by tick (:mod:`pegame.vector.metrics`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from gymnasium import spaces
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+from omegaconf import DictConfig
+
+from pegame.envs.core import check_seed
+from pegame.envs.settings import env_config, env_settings
+from pegame.errors import ConfigError
+from pegame.loop import ROLES
+from pegame.vector import BatchedGame
+
+#: the ``role`` values of :func:`vector_env`: one learner, or both (self-play)
+VECTOR_ROLES = ("pursuer", "evader", "both")
+
+
+class _Batch:
+    """What the batched envs share: the batched game of ``roles``, seeding, actions,
+    autoreset and infos."""
+
+    def _setup(self, num_envs, config, overrides, opponents, roles, settings) -> None:
+        self.settings = env_settings(**settings)
+        cfg = env_config(config, overrides, opponents)
+        self.game = BatchedGame(cfg, self.settings, roles, num_envs)
+        self.num_envs = self.game.num_games
+        self.roles = tuple(roles)
+        self.layouts = {role: self.game.features[role].layout for role in self.roles}
+        self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
+        self._autoreset = np.zeros(self.num_envs, np.bool_)
+        self._all = np.arange(self.num_envs)
+        self._started = False
+
+    def _observation_space(self, role: str) -> spaces.Box:
+        features = self.game.features[role]
+        return spaces.Box(features.low, features.high, dtype=np.float32)
+
+    def _seeds(self, seed) -> list[int | None]:
+        """Per-game seeds as SyncVectorEnv.reset takes them."""
+        if seed is None:
+            return [None] * self.num_envs
+        if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+            return [check_seed(int(seed)) + i for i in range(self.num_envs)]
+        seeds = list(seed)
+        if len(seeds) != self.num_envs:
+            raise ValueError(
+                f"seed must be None, an integer or a list of {self.num_envs} seeds "
+                f"(one per env), got {len(seeds)}."
+            )
+        return [check_seed(s) for s in seeds]
+
+    def _game_seeds(self, games: np.ndarray, seeds: Sequence[int | None]) -> list[int]:
+        """The master seed of each game: its seed, else one drawn from its generator
+        (the single env's ``reset``: ``game_seed``)."""
+        out = []
+        for game, seed in zip(games.tolist(), seeds):
+            if seed is not None or self._rngs[game] is None:
+                self._rngs[game] = seeding.np_random(seed)[0]
+            out.append(int(self._rngs[game].integers(2**63 - 1)) if seed is None else int(seed))
+        return out
+
+    def _reset(self, seed, options) -> None:
+        seeds = self._seeds(seed)
+        self.game.reset_games(self._all, self._game_seeds(self._all, seeds))
+        self._autoreset[:] = False
+        self._started = True
+
+    def _commands(self, actions, playing: np.ndarray) -> dict[str, np.ndarray]:
+        """role -> (N, 2) (v, w) of the learners' batched ``actions`` (role -> (N, 2) in
+        [-1, 1]); ValueError for a bad one among the games playing."""
+        out = {}
+        for role in self.roles:
+            body = self.game.context.pursuer if role == "pursuer" else self.game.context.evader
+            a = np.asarray(actions[role])
+            if a.shape != (self.num_envs, 2):
+                raise ValueError(
+                    f"{role} actions must have shape ({self.num_envs}, 2) (v, w) in [-1, 1] "
+                    f"per env, got shape {a.shape}."
+                )
+            a = a.astype(np.float64)
+            live = a[playing]
+            if not np.isfinite(live).all():
+                raise ValueError(
+                    f"{role} actions must be finite, got {a[playing][~np.isfinite(live).all(1)][0]!r}."
+                )
+            if np.abs(live).max(initial=0.0) > 1.0:
+                if not self.settings.clip_actions:
+                    bad = live[(np.abs(live) > 1.0).any(axis=1)][0]
+                    raise ValueError(
+                        f"{role} actions must lie in [-1, 1] (scaled v, w), got {bad!r}; "
+                        "pass clip_actions=True to clip instead."
+                    )
+                a = np.clip(a, -1.0, 1.0)
+            out[role] = a * np.array([body.v_max, body.w_max])
+        return out
+
+    def _advance(self, actions) -> tuple[np.ndarray, np.ndarray, dict]:
+        """Step the playing games, reset the ones that ended last step (NEXT_STEP).
+        Returns the rewards, the games that ended and the infos."""
+        if not self._started:
+            raise RuntimeError("No games in progress: call reset() before step().")
+        resetting = self._autoreset.copy()
+        playing = ~resetting
+        rewards = self.game.step(playing, self._commands(actions, playing))
+        infos: dict = {}
+        if resetting.any():
+            games = np.flatnonzero(resetting)
+            self.game.reset_games(games, self._game_seeds(games, [None] * games.size))
+        if playing.any():
+            infos["time"] = np.where(playing, self.game.time(), 0.0)
+            infos["_time"] = playing.copy()
+            infos["tracking_rate"] = np.where(playing, self.game.tracking_rate(), 0.0)
+            infos["_tracking_rate"] = playing.copy()
+        ended = playing & self.game.done
+        for game in np.flatnonzero(ended).tolist():
+            self._add_info(infos, {"metrics": self.game.summary(game)}, game)
+        if resetting.any():
+            self._seed_info(infos, resetting)
+        self._autoreset = ended.copy()  # the caller may keep or change what it is given
+        return rewards, ended, infos
+
+    def _seed_info(self, infos: dict, games: np.ndarray) -> dict:
+        infos["seed"] = np.where(games, self.game.seeds, 0)
+        infos["_seed"] = games.copy()
+        return infos
+
+
+class _LearnerVectorEnv(_Batch, VectorEnv):
+    """One learner, ``role``, against the opponent strategy ``opponent``.
+
+    num_envs: games stepped together; config / overrides / opponent: as the single env
+    (:class:`pegame.envs.single.PursuitEnv`); settings: :class:`EnvSettings` fields.
+    """
+
+    role: str
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __init__(
+        self,
+        num_envs: int,
+        config: DictConfig | None = None,
+        overrides: Sequence[str] = (),
+        opponent: str | None = None,
+        **settings,
+    ) -> None:
+        other = "evader" if self.role == "pursuer" else "pursuer"
+        opponents = {other: opponent} if opponent is not None else None
+        self._setup(num_envs, config, overrides, opponents, (self.role,), settings)
+        self.opponent = str(self.game.scenario.names[other])
+        self.layout = self.layouts[self.role]
+        self.single_observation_space = self._observation_space(self.role)
+        self.single_action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._sign = 1.0 if self.role == "pursuer" else -1.0
+
+    def reset(self, *, seed: int | list[int | None] | None = None, options: dict | None = None):
+        """Start a game in every env; ``seed`` as ``SyncVectorEnv.reset`` takes it."""
+        self._reset(seed, options)
+        infos = self._seed_info({}, np.ones(self.num_envs, np.bool_))
+        return self.game.observations(self.role), infos
+
+    def step(self, actions):
+        """One decision period of every game ((N, 2) actions; ValueError for a bad one)."""
+        rewards, ended, infos = self._advance({self.role: actions})
+        return (
+            self.game.observations(self.role),
+            self._sign * rewards,
+            np.zeros(self.num_envs, np.bool_),
+            ended,
+            infos,
+        )
+
+    def close_extras(self, **kwargs) -> None:
+        """Nothing to release: the games hold no simulator processes."""
+
+
+class PursuitVectorEnv(_LearnerVectorEnv):
+    """The batched ``pegame/Pursuit-v0``: the learners are the pursuers."""
+
+    role = "pursuer"
+
+
+class EvasionVectorEnv(_LearnerVectorEnv):
+    """The batched ``pegame/Evasion-v0``: the learners are the evaders. A pursuer
+    strategy opponent runs with its estimator per game in Python; the random pursuer
+    with ``model=action`` runs batched and without one, so that its games' estimation
+    measures are None (see :mod:`pegame.vector.opponents`)."""
+
+    role = "evader"
+
+
+class SelfPlayVectorEnv(_Batch):
+    """Both roles learning in ``num_envs`` games: the batched PettingZoo env.
+
+    ``reset`` and ``step`` take and return dicts keyed by agent ('pursuer', 'evader') of
+    batched arrays: observations (N, size), actions (N, 2), rewards (N,) (the evader's
+    is the pursuer's negative), terminations and truncations (N,); infos is one dict for
+    all games (as the vector envs'). Autoreset as the vector envs.
+    """
+
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+    _add_info = VectorEnv._add_info
+
+    def __init__(
+        self,
+        num_envs: int,
+        config: DictConfig | None = None,
+        overrides: Sequence[str] = (),
+        **settings,
+    ) -> None:
+        self._setup(num_envs, config, overrides, None, ROLES, settings)
+        self.possible_agents = list(ROLES)
+        self.single_observation_spaces = {role: self._observation_space(role) for role in ROLES}
+        self.single_action_spaces = {
+            role: spaces.Box(-1.0, 1.0, (2,), np.float32) for role in ROLES
+        }
+        self.observation_spaces = {
+            role: batch_space(space, self.num_envs)
+            for role, space in self.single_observation_spaces.items()
+        }
+        self.action_spaces = {
+            role: batch_space(space, self.num_envs)
+            for role, space in self.single_action_spaces.items()
+        }
+
+    def _observations(self) -> dict[str, np.ndarray]:
+        return {role: self.game.observations(role) for role in ROLES}
+
+    def reset(self, *, seed=None, options: dict | None = None):
+        """Start a game in every env; ``seed`` as the vector envs take it."""
+        self._reset(seed, options)
+        return self._observations(), self._seed_info({}, np.ones(self.num_envs, np.bool_))
+
+    def step(self, actions: dict[str, np.ndarray]):
+        """One decision period of every game with both agents' (N, 2) actions."""
+        if not isinstance(actions, dict) or sorted(actions) != sorted(ROLES):
+            raise ValueError(f"actions must map each agent in {list(ROLES)} to its (N, 2) actions.")
+        rewards, ended, infos = self._advance(actions)
+        never = np.zeros(self.num_envs, np.bool_)
+        return (
+            self._observations(),
+            {"pursuer": rewards, "evader": -rewards},
+            dict.fromkeys(ROLES, never),
+            dict.fromkeys(ROLES, ended),
+            infos,
+        )
+
+    def close(self) -> None:
+        """Nothing to release."""
+
+
+def vector_env(
+    num_envs: int,
+    config: DictConfig | None = None,
+    overrides: Sequence[str] = (),
+    opponent: str | None = None,
+    role: str = "pursuer",
+    **settings,
+) -> PursuitVectorEnv | EvasionVectorEnv | SelfPlayVectorEnv:
+    """``num_envs`` games stepped together for a learning ``role``: 'pursuer'
+    (:class:`PursuitVectorEnv`), 'evader' (:class:`EvasionVectorEnv`), both against
+    ``opponent`` (a strategy name, as the single envs take it), or 'both'
+    (:class:`SelfPlayVectorEnv`, no opponent). config / overrides / settings: as the
+    single envs (:mod:`pegame.envs.single`)."""
+    if role not in VECTOR_ROLES:
+        raise ConfigError(
+            f"Invalid value for 'role': {role!r}. Allowed: {', '.join(VECTOR_ROLES)}."
+        )
+    if role == "both":
+        if opponent is not None:
+            raise ConfigError(
+                "role='both' has no opponent: both agents learn; leave opponent unset."
+            )
+        return SelfPlayVectorEnv(num_envs, config, overrides, **settings)
+    cls = PursuitVectorEnv if role == "pursuer" else EvasionVectorEnv
+    return cls(num_envs, config, overrides, opponent, **settings)
+
+
+__all__ = [
+    "EvasionVectorEnv",
+    "PursuitVectorEnv",
+    "SelfPlayVectorEnv",
+    "VECTOR_ROLES",
+    "vector_env",
+]

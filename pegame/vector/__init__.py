@@ -1,0 +1,18 @@
+"""Batched games: thousands of pegame games stepped together by numba kernels.
+
+- :mod:`pegame.vector.game`: :class:`BatchedGame`, many games of one scenario, each the
+  game the single env plays with the same seed, in the tick loop's order;
+- :mod:`pegame.vector.kernels`: the tick of every game (simulator, measures) as numba
+  kernels, parallel over games; :mod:`pegame.vector.camera` (detector, ground truth) and
+  :mod:`pegame.vector.features` (observations) per game; :mod:`pegame.vector.state` the
+  arrays and numbers they take;
+- :mod:`pegame.vector.opponents`: the scripted opponent of a learner;
+- :mod:`pegame.vector.metrics`: the measures kept as running sums;
+- :mod:`pegame.vector.exact`: Python's hypot and angle wrap, bit for bit, in numba.
+
+The Gymnasium vector envs on it are in :mod:`pegame.envs.vector`.
+"""
+
+from pegame.vector.game import BatchedGame
+
+__all__ = ["BatchedGame"]

@@ -1,0 +1,208 @@
+"""What the pursuer's camera gives in a batched game, per game: the oracle detector and
+the ground truth in_view, the same tests and float operations as the plain code.
+
+- :func:`segment_clear` is :func:`pegame.visibility.sight._segment_clear` (the same
+  samples, found in a vectorised pass);
+- :func:`point_in_view` and :func:`body_in_view` are :func:`pegame.visibility.in_view` and
+  :func:`pegame.visibility.body_in_view`;
+- :func:`detect` is the oracle detector with every part of the perception model off
+  (:class:`pegame.detectors.oracle.OracleDetector`: FOV, range and line of sight of the
+  evader's centre, then the pinhole box and the depth back-projection);
+- :func:`sense` is the loop's ``_sense`` (detection, then in_view) with the pursuer
+  observation's memory of the last detection.
+
+Python's ``math.hypot`` and :func:`pegame.types.wrap_angle` come from
+:mod:`pegame.vector.exact`. ``tests/test_vector_kernels.py`` compares them with the plain
+functions.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from pegame.vector.exact import (
+    cell_by_division,
+    cell_by_product,
+    hypot,
+    hypot_within,
+    wrap_angle,
+)
+from pegame.vector.state import (
+    BODY_HEIGHT,
+    BOX_H,
+    BOX_W,
+    BOX_X,
+    BOX_Y,
+    CAMERA_HEIGHT,
+    DEPTH,
+    DETECTION_RANGE,
+    EVADER,
+    FAR,
+    FOCAL,
+    FOV,
+    IMAGE_HEIGHT,
+    IMAGE_WIDTH,
+    NEAR,
+    PURSUER,
+    RADIUS,
+    SEEN_X,
+    SEEN_Y,
+)
+from pegame.visibility.sight import SILHOUETTE
+
+_SILHOUETTE = np.array(SILHOUETTE)
+
+#: line-of-sight samples whose cells are found together (one vectorised pass)
+_CHUNK = 32
+
+
+@njit(cache=True, inline="always")
+def _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, rotated):
+    """The cells (1 + flat index, 0 off the grid) of samples start..start + size - 1 of
+    the segment into ``cells`` by :func:`pegame.vector.exact.cell_by_product`; returns
+    whether all are decided. Inlined with ``rotated`` a constant (no branch in the loop).
+    """
+    frame = world.frame
+    height, width = world.blocked.shape
+    ox, oy, gc, gs = frame[0], frame[1], frame[2], frame[3]
+    inverse, dt = 1.0 / frame[5], 1.0 / count
+    decided = True
+    for j in range(size):
+        k = start + j
+        t = 1.0 if k == count else k * dt
+        u = ax + t * dx - ox
+        v = ay + t * dy - oy
+        if rotated:
+            u, v = gc * u + gs * v, -gs * u + gc * v
+        cells[j], ok = cell_by_product(u, v, inverse, height, width)
+        decided &= ok
+    return decided
+
+
+@njit(cache=True)
+def segment_clear(world, ax, ay, bx, by, step):
+    """:func:`pegame.visibility.sight._segment_clear` on the grid: True when no sample of
+    the segment from (ax, ay) to (bx, by) (m), ``step`` m apart, lies in a blocked or
+    off-grid cell. The same samples and cells (the tests compare the two), found
+    _CHUNK at a time from products (:func:`pegame.vector.exact.cell_by_product`; a chunk
+    with a sample near a cell edge is found again by the division), then looked up in
+    world.sight_values (entry 0: off the grid, blocked); the test stops at the first
+    chunk with a blocked cell."""
+    frame, values = world.frame, world.sight_values
+    height, width = world.blocked.shape
+    ox, oy, gc, gs, rotated, res = frame[0], frame[1], frame[2], frame[3], frame[4] != 0.0, frame[5]
+    count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
+    dx, dy = bx - ax, by - ay
+    dt = 1.0 / count
+    cells = np.empty(_CHUNK, np.int64)
+    for start in range(0, count + 1, _CHUNK):
+        size = min(_CHUNK, count + 1 - start)
+        if rotated:
+            decided = _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, True)
+        else:
+            decided = _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, False)
+        if not decided:
+            for j in range(size):
+                k = start + j
+                t = 1.0 if k == count else k * dt
+                u = ax + t * dx - ox
+                v = ay + t * dy - oy
+                if rotated:
+                    u, v = gc * u + gs * v, -gs * u + gc * v
+                cells[j] = cell_by_division(u, v, res, height, width)
+        for j in range(size):
+            if values[cells[j]]:
+                return False
+    return True
+
+
+@njit(cache=True)
+def point_in_view(world, camera, px, py, ptheta, x, y):
+    """:func:`pegame.visibility.in_view` of the map point (x, y) (m) from the camera at
+    (px, py, ptheta)."""
+    dx, dy = x - px, y - py
+    if not hypot_within(dx, dy, camera[NEAR], camera[FAR]):
+        return False
+    if abs(wrap_angle(math.atan2(dy, dx) - ptheta)) > 0.5 * camera[FOV]:
+        return False
+    return segment_clear(world, px, py, x, y, 0.5 * world.frame[5])
+
+
+@njit(cache=True)
+def body_in_view(world, camera, px, py, ptheta, x, y, radius, centre):
+    """:func:`pegame.visibility.body_in_view`: any SILHOUETTE point of the body of
+    ``radius`` m at (x, y) in view; ``centre``: whether its centre (the first point,
+    x + 0 = x) is, already known from the detector."""
+    if centre:
+        return True
+    dx, dy = x - px, y - py
+    distance = hypot(dx, dy)
+    ax, ay = (-dy / distance, dx / distance) if distance > 0.0 else (0.0, 0.0)
+    for k in _SILHOUETTE[1:]:
+        if point_in_view(world, camera, px, py, ptheta, x + k * radius * ax, y + k * radius * ay):
+            return True
+    return False
+
+
+@njit(cache=True)
+def detect(world, rules, state, game):
+    """The oracle detector's capture for ``game``'s current poses, into state.detected
+    and state.detection (the pipeline's parts all off). Returns whether the evader's
+    centre is in view."""
+    camera = rules.camera
+    cx, cy, ctheta = state.poses[game, PURSUER]
+    ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
+    state.detected[game] = False
+    if not point_in_view(world, camera, cx, cy, ctheta, ex, ey):
+        return False
+    distance = hypot(ex - cx, ey - cy)
+    if not distance <= camera[DETECTION_RANGE]:
+        return True
+    bearing = wrap_angle(math.atan2(ey - cy, ex - cx) - ctheta)
+    depth = distance * math.cos(bearing)
+    depth = depth if depth > camera[NEAR] else camera[NEAR]
+    # pinhole_box
+    width, height, focal = camera[IMAGE_WIDTH], camera[IMAGE_HEIGHT], camera[FOCAL]
+    ratio = rules.bodies[EVADER, RADIUS] / distance
+    half = math.asin(ratio if ratio < 1.0 else 1.0)
+    left = 0.5 * width - focal * math.tan(bearing + half)
+    left = left if left > 0.0 else 0.0
+    right = 0.5 * width - focal * math.tan(bearing - half)
+    right = right if right < width else width
+    middle = 0.5 * height
+    top = middle - focal * (camera[BODY_HEIGHT] - camera[CAMERA_HEIGHT]) / depth
+    top = top if top > 0.0 else 0.0
+    bottom = middle + focal * camera[CAMERA_HEIGHT] / depth
+    bottom = bottom if bottom < height else height
+    box_w = right - left
+    centre = left + 0.5 * box_w
+    seen_bearing = math.atan2(0.5 * width - centre, focal)
+    seen_range = depth / math.cos(seen_bearing)
+    heading = ctheta + seen_bearing
+    out = state.detection[game]
+    out[BOX_X], out[BOX_Y], out[BOX_W], out[BOX_H] = left, top, box_w, bottom - top
+    out[DEPTH] = depth
+    out[SEEN_X] = cx + seen_range * math.cos(heading)
+    out[SEEN_Y] = cy + seen_range * math.sin(heading)
+    state.detected[game] = True
+    return True
+
+
+@njit(cache=True)
+def sense(world, rules, state, game):
+    """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
+    pursuer observation's memory of the last detection (``PursuerFeatures.remember``)."""
+    centre = detect(world, rules, state, game)
+    px, py, ptheta = state.poses[game, PURSUER]
+    ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
+    state.in_view[game] = body_in_view(
+        world, rules.camera, px, py, ptheta, ex, ey, rules.bodies[EVADER, RADIUS], centre
+    )
+    if state.detected[game]:
+        state.seen[game, 0] = state.steps[game] * rules.control_dt
+        state.seen[game, 1] = state.detection[game, SEEN_X]
+        state.seen[game, 2] = state.detection[game, SEEN_Y]
+        state.has_seen[game] = True

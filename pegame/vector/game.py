@@ -1,0 +1,294 @@
+"""Many games of one scenario stepped together: the batched counterpart of
+:class:`pegame.envs.core.EnvGame` on the tick loop (:class:`pegame.loop.TickLoop`).
+
+A :class:`BatchedGame` holds ``num_games`` games of one :class:`pegame.game.Scenario`
+with the learning ``roles`` commanded from outside. Each game is the game the single env
+plays with the same master seed: the same SeedSequence streams (:data:`pegame.game.STREAMS`),
+the same spawn (:func:`pegame.game.spawn`), the opponent strategy built from its own
+stream, and the same tick.
+
+The order of a tick is the loop's, for the loop's case of external learners and no
+estimator (``TickLoop.advance`` with ``estimate=False``), one step of each below per
+step of ``advance``:
+
+=====================================  =====================================================
+TickLoop.advance                       BatchedGame.step (per control tick)
+=====================================  =====================================================
+opponent observes; decides at a        opponent.command (a strategy per game, in Python),
+decision tick; gives its command       or the kernel reads the opponent's action table
+metrics.add(current tick)              kernels.tally
+_integrate: substeps, pursuer then     kernels.move(pursuer), kernels.move(evader), per
+evader (GridSimulator.step)            substep
+step += 1; _sense(): poses, detector,  steps += 1; camera.sense: camera.detect, then
+in_view                                camera.body_in_view
+EnvGame: reward += detection,          camera.sense (memory), state.rewards
+features.remember
+=====================================  =====================================================
+
+and ``TickLoop.start`` (spawn, plugin resets, sense tick 0) is :meth:`reset_games`. The
+kernels play every game's tick in one call (:func:`pegame.vector.kernels.play`, parallel
+over games from ``PARALLEL_GAMES`` games on: below, starting numba's threads costs more
+than it saves). ``tests/test_vector_env.py`` plays the batched and the single env side
+by side, through autoresets and with each opponent, which keeps the two orders the same.
+
+Why a mirror and not the loop itself: ``TickLoop.advance`` drives one game's plugin
+objects with Python values (poses, detections, velocities), and its cost per game is
+what the batch exists to remove; a loop generic over batched plugins would need a
+batched version of every plugin interface. The kernels keep the loop's order instead,
+and the side-by-side test is the contract.
+
+What the batched game plays (anything else is a ConfigError at construction): the grid
+simulator; the oracle detector with its perception parts off (the default; no misses,
+noise, rate, latency or false positives); ``game.turn_order=simultaneous``; no belief in
+the observation. A pursuer strategy as the opponent adds the loop's estimation per game
+in Python (:class:`pegame.vector.opponents.PursuerStrategyOpponent`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from omegaconf import DictConfig
+
+from pegame.detectors.oracle import OracleDetector
+from pegame.detectors.perception import detection_range
+from pegame.envs.crop import LocalCrop
+from pegame.envs.observations import EvaderFeatures, PursuerFeatures
+from pegame.envs.settings import EnvSettings
+from pegame.errors import ConfigError
+from pegame.game import STREAMS, Scenario, spawn
+from pegame.navigation import shared_inflation
+from pegame.sims.grid import GridSimulator
+from pegame.vector import kernels
+from pegame.vector.features import features
+from pegame.vector.metrics import new_tally, summary
+from pegame.vector.opponents import opponent_for
+from pegame.vector.state import (
+    DETECTED,
+    EVADER,
+    PURSUER,
+    TICKS,
+    BatchState,
+    Rules,
+    World,
+    new_state,
+)
+
+#: the oracle detector's perception fields and the values the kernels play
+PERCEPTION_OFF = {
+    "rate": None,
+    "latency": 0.0,
+    "miss_probability": 0.0,
+    "burst_miss_fraction": 0.0,
+    "miss_range_start": None,
+    "occlusion_miss": 0.0,
+    "range_noise": 0.0,
+    "range_noise_growth": 0.0,
+    "bearing_noise": 0.0,
+    "false_positive_rate": 0.0,
+}
+
+
+def check_playable(scenario: Scenario, settings: EnvSettings) -> None:
+    """ConfigError naming the first key whose value the batched game does not play."""
+
+    def refuse(key: str, value, allowed: str) -> None:
+        raise ConfigError(
+            f"Invalid value for '{key}' in a batched env: {value!r}. Allowed: {allowed} "
+            "(the batched kernels play only these; use the single env for the rest)."
+        )
+
+    if scenario.classes["sim"] is not GridSimulator:
+        refuse("sim", scenario.names["sim"], "grid")
+    if scenario.classes["detector"] is not OracleDetector:
+        refuse("detector", scenario.names["detector"], "oracle")
+    for key, off in PERCEPTION_OFF.items():
+        value = getattr(scenario.configs["detector"], key)
+        if value != off:
+            refuse(f"detector.{key}", value, repr(off))
+    if scenario.settings.turn_order != "simultaneous":
+        refuse("game.turn_order", scenario.settings.turn_order, "simultaneous")
+    if settings.belief:
+        refuse("belief", settings.belief, "False (no estimator runs in the batched game)")
+
+
+class BatchedGame:
+    """``num_games`` games of ``cfg`` (a composed run config) with the learners ``roles``
+    (a subset of ('pursuer', 'evader')); the other role, if any, is the config's strategy.
+    settings: the env's :class:`EnvSettings`."""
+
+    def __init__(
+        self, cfg: DictConfig, settings: EnvSettings, roles: Sequence[str], num_games: int
+    ) -> None:
+        if not (isinstance(num_games, (int, np.integer)) and num_games >= 1):
+            raise ConfigError(
+                f"Invalid value for 'num_envs': {num_games!r}. Allowed: a whole number >= 1."
+            )
+        self.settings = settings
+        self.roles = tuple(roles)
+        self.num_games = int(num_games)
+        self.scenario = scenario = Scenario(cfg)
+        check_playable(scenario, settings)
+        context = scenario.context
+        self.context = context
+        self.ticks_per_action = settings.ticks_per_action(context.control_dt)
+        self.features = {
+            "pursuer": PursuerFeatures(context, settings.observation),
+            "evader": EvaderFeatures(context, settings.observation),
+        }
+        self.world = _world(context.grid, context, settings)
+        self.rules = _rules(scenario)
+        self.state: BatchState = new_state(self.num_games)
+        self.state.tally[:] = new_tally()
+        self.opponent = (
+            opponent_for(scenario, self.roles[0], self.rules.bodies, self.num_games)
+            if len(self.roles) == 1
+            else None
+        )
+        self.seeds = np.zeros(self.num_games, np.int64)
+
+    @property
+    def steps(self) -> int:
+        """Env steps in one game."""
+        return -(-self.rules.ticks // self.ticks_per_action)
+
+    @property
+    def done(self) -> np.ndarray:
+        """Bool (N,): the games whose every tick has been played."""
+        return self.state.steps >= self.rules.ticks
+
+    def reset_games(self, games: np.ndarray, seeds: Sequence[int]) -> None:
+        """Start a new game in each slot of ``games`` with the master seed of the same
+        position in ``seeds`` (TickLoop.start: spawn, resets, tick 0 sensed)."""
+        state, context = self.state, self.context
+        games = np.asarray(games, dtype=np.int64)
+        opponent = self.opponent
+        for game, seed in zip(games.tolist(), seeds):
+            streams = dict(zip(STREAMS, np.random.SeedSequence(seed).spawn(len(STREAMS))))
+            pursuer, evader = spawn(context, np.random.default_rng(streams["spawn"]))
+            self.seeds[game] = seed
+            state.poses[game, PURSUER] = (pursuer.x, pursuer.y, pursuer.theta)
+            state.poses[game, EVADER] = (evader.x, evader.y, evader.theta)
+            if opponent is not None:
+                opponent.reset(game, streams, pursuer if opponent.role == PURSUER else evader)
+        state.velocities[games] = 0.0
+        state.commands[games] = 0.0
+        state.steps[games] = 0
+        state.has_seen[games] = False
+        state.tally[games] = new_tally()
+        kernels.sense_games(self.world, self.rules, state, games)
+        if opponent is not None:
+            opponent.sensed(state, games, self.context.control_dt)
+
+    def step(self, playing: np.ndarray, commands: dict[str, np.ndarray]) -> np.ndarray:
+        """One env step (``ticks_per_action`` control ticks) of the games where ``playing``
+        (bool (N,)) is set, with the learners' ``commands`` (role -> (N, 2) (v, w) in m/s
+        and rad/s, rows of other games ignored). Returns the rewards (N,): the pursuer's
+        detections counted at the ticks reached (0 for games not playing)."""
+        state, rules = self.state, self.rules
+        state.rewards[:] = 0.0
+        for role, command in commands.items():
+            index = PURSUER if role == "pursuer" else EVADER
+            state.commands[playing, index] = command[playing]
+        opponent = self.opponent
+        if opponent is None or opponent.table is not None:
+            table = _NO_TABLE if opponent is None else opponent.table
+            role = -1 if opponent is None else opponent.role
+            kernels.play(self.world, rules, state, playing, self.ticks_per_action, table, role)
+        else:
+            for _ in range(self.ticks_per_action):
+                live = playing & (state.steps < rules.ticks)
+                games = np.flatnonzero(live)
+                steps = state.steps[games]
+                opponent.command(
+                    state, games, steps * rules.control_dt, steps % rules.decide_every == 0
+                )
+                kernels.play(self.world, rules, state, live, 1, _NO_TABLE, -1)
+                opponent.sensed(state, games, rules.control_dt)
+        return state.rewards.copy()
+
+    def observations(self, role: str) -> np.ndarray:
+        """Float32 (N, size): ``role``'s observation in every game (a new array)."""
+        out = np.empty((self.num_games, self.features[role].size), dtype=np.float32)
+        features(self.world, self.rules, self.state, out, PURSUER if role == "pursuer" else EVADER)
+        return out
+
+    def time(self) -> np.ndarray:
+        """Float64 (N,): every game's simulation time (s), as ``TickLoop.time``."""
+        return self.state.steps * self.context.control_dt
+
+    def tracking_rate(self) -> np.ndarray:
+        """Float64 (N,): the fraction of the ticks played with the evader detected."""
+        tally = self.state.tally
+        ticks = tally[:, TICKS]
+        return np.divide(tally[:, DETECTED], ticks, out=np.zeros(self.num_games), where=ticks > 0)
+
+    def summary(self, game: int) -> dict:
+        """Game ``game``'s measures (``TrackingMetrics.summary``): a pursuer strategy's
+        opponent keeps them itself (with the estimator's), else the kernels' tally."""
+        metrics = getattr(self.opponent, "metrics", None)
+        if metrics is not None:
+            return metrics[game].summary()
+        return summary(self.state.tally[game], self.context.control_dt)
+
+
+_NO_TABLE = np.zeros((1, 1, 2))
+
+
+def _world(grid, context, settings: EnvSettings) -> World:
+    crop = LocalCrop(grid, settings.crop_cells, settings.crop_resolution)
+    x0, x1, y0, y1 = grid.extent
+    masks = np.stack(
+        [
+            shared_inflation(grid, context.pursuer.radius),
+            shared_inflation(grid, context.evader.radius),
+        ]
+    )
+    return World(
+        grid.blocked,
+        np.array(grid.kernel_frame, dtype=np.float64),
+        masks,
+        crop._pooled,
+        crop._off_x,
+        crop._off_y,
+        np.array(crop._origin, dtype=np.float64),
+        np.concatenate([[1.0], crop._pooled.ravel()]).astype(np.float32),
+        np.concatenate([[True], grid.blocked.ravel()]),
+        np.array([x0, y0, 2.0 / (x1 - x0), 2.0 / (y1 - y0), math.hypot(x1 - x0, y1 - y0)]),
+    )
+
+
+def _rules(scenario: Scenario) -> Rules:
+    context, settings = scenario.context, scenario.settings
+    camera, detector = context.camera, scenario.configs["detector"]
+    bodies = np.array(
+        [
+            [body.radius, body.v_max, body.w_max, body.a_max, body.alpha_max]
+            for body in (context.pursuer, context.evader)
+        ],
+        dtype=np.float64,
+    )
+    numbers = np.array(
+        [
+            camera.fov,
+            camera.near,
+            camera.far,
+            float(camera.image_width),
+            float(camera.image_height),
+            camera.focal_px,
+            detection_range(detector, camera),
+            detector.evader_height,
+            detector.camera_height,
+        ],
+        dtype=np.float64,
+    )
+    return Rules(
+        bodies,
+        numbers,
+        float(context.control_dt),
+        int(settings.substeps),
+        int(settings.decide_every),
+        int(settings.ticks),
+    )

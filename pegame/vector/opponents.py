@@ -1,0 +1,190 @@
+"""The scripted role of a batched game: the opponent of a learner.
+
+- :class:`ActionTable`: the random agent with ``model=action``
+  (:class:`pegame.wander.RandomActions`), batched: at a game's reset every decision's
+  (v, w) is drawn at once from the strategy's own generator, the same numbers the
+  strategy would draw one decision at a time, and the tick kernel reads them;
+- :class:`StrategyOpponent`: any other evader strategy (``smart``, ``random`` with
+  ``model=waypoint``, any plugin): one instance per game, built exactly as
+  :class:`pegame.game.Game` builds it and asked, game by game in Python, for its decision
+  and its command at every tick. It costs what the strategy costs in a single game.
+- :class:`PursuerStrategyOpponent`: any other pursuer strategy, with what a pursuer
+  strategy is given: its detection, the visibility region and the belief of the game's
+  estimator (one per game, built as Game builds it, updated every tick in Python as the
+  loop does), and that game's measures kept by :class:`pegame.metrics.TrackingMetrics`
+  itself (the estimator's included). It costs the strategy and the estimator per game.
+
+The action table ignores what it sees, so no estimator runs with it: its games' measures
+have no estimation error, n_eff or resamplings (None and 0).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pegame.api import EvaderObservation, PursuerObservation
+from pegame.evaders.random import RandomEvader
+from pegame.metrics import TrackingMetrics
+from pegame.pursuers.random import RandomPursuer
+from pegame.types import BoundingBox, Detection, Pose
+from pegame.vector.state import (
+    BOX_H,
+    BOX_W,
+    BOX_X,
+    BOX_Y,
+    DEPTH,
+    EVADER,
+    PURSUER,
+    SEEN_X,
+    SEEN_Y,
+    V_MAX,
+    W_MAX,
+)
+from pegame.visibility import VisibilityRegion
+
+
+class ActionTable:
+    """The random (v, w) actions of ``role`` (0 pursuer, 1 evader) for ``num_games`` games
+    of ``decisions`` decisions each, drawn per game at its reset; ``body``: the role's
+    (radius, v_max, w_max, ...) row of the kernels' bodies."""
+
+    def __init__(self, role: int, body: np.ndarray, num_games: int, decisions: int) -> None:
+        self.role = role
+        self.v_max, self.w_max = float(body[V_MAX]), float(body[W_MAX])
+        self.table = np.zeros((num_games, decisions, 2))
+        self.name = "pursuer" if role == PURSUER else "evader"
+
+    def reset(self, game: int, streams: dict, pose: Pose) -> None:
+        """Draw game ``game``'s actions from the role's stream (of the game's ``streams``,
+        :data:`pegame.game.STREAMS`): uniform(0, v_max) and uniform(-w_max, w_max) per
+        decision, in the order RandomActions.decide draws them (numpy's uniform is
+        low + (high - low) * next_double, computed the same way here)."""
+        rng = np.random.default_rng(streams[self.name])
+        u = rng.random(2 * self.table.shape[1]).reshape(-1, 2)
+        self.table[game, :, 0] = 0.0 + (self.v_max - 0.0) * u[:, 0]
+        self.table[game, :, 1] = -self.w_max + (self.w_max - -self.w_max) * u[:, 1]
+
+    def command(self, state, games: np.ndarray, time: np.ndarray, deciding: np.ndarray) -> None:
+        """Nothing: the tick kernel reads the table."""
+
+    def sensed(self, state, games: np.ndarray, dt: float) -> None:
+        """Nothing: the table does not look."""
+
+
+class StrategyOpponent:
+    """The evader strategy ``cls`` with ``config`` in ``context``, one per game."""
+
+    role = EVADER
+    table = None
+
+    def __init__(self, cls, config, context, num_games: int) -> None:
+        self.cls, self.config, self.context = cls, config, context
+        self.strategies: list = [None] * num_games
+
+    def reset(self, game: int, streams: dict, pose: Pose) -> None:
+        """A new strategy for ``game`` with the evader's stream of ``streams``, reset at
+        ``pose``."""
+        strategy = self.cls(self.config, self.context, np.random.default_rng(streams["evader"]))
+        strategy.reset(pose)
+        self.strategies[game] = strategy
+
+    def sensed(self, state, games: np.ndarray, dt: float) -> None:
+        """Nothing: the evader is told the poses when it is asked."""
+
+    def command(self, state, games: np.ndarray, time: np.ndarray, deciding: np.ndarray) -> None:
+        """Write the strategies' commands for ``games`` into state.commands: each is given
+        its observation at ``time[k]`` s and decides first where ``deciding[k]`` (the
+        loop's order)."""
+        poses, commands = state.poses, state.commands
+        for k, game in enumerate(games.tolist()):
+            p, e = poses[game, PURSUER].tolist(), poses[game, EVADER].tolist()
+            observation = EvaderObservation(float(time[k]), Pose(*e), Pose(*p), None)
+            strategy = self.strategies[game]
+            if deciding[k]:
+                strategy.decide(observation)
+            cmd = strategy.control(observation)
+            commands[game, EVADER, 0], commands[game, EVADER, 1] = cmd.v, cmd.w
+
+
+class PursuerStrategyOpponent:
+    """The pursuer strategy ``cls`` with ``config``, and the estimator ``estimator`` (a
+    (class, config) pair), in ``context``, one of each per game."""
+
+    role = PURSUER
+    table = None
+
+    def __init__(self, cls, config, estimator, context, num_games: int) -> None:
+        self.cls, self.config, self.context = cls, config, context
+        self.estimator_cls, self.estimator_config = estimator
+        self.strategies: list = [None] * num_games
+        self.estimators: list = [None] * num_games
+        self.metrics: list[TrackingMetrics | None] = [None] * num_games
+        self.seen: list = [None] * num_games  # (detection, region, belief) of the tick
+
+    def reset(self, game: int, streams: dict, pose: Pose) -> None:
+        """A new strategy and estimator for ``game`` from ``streams``, reset at ``pose``."""
+        context = self.context
+        strategy = self.cls(self.config, context, np.random.default_rng(streams["pursuer"]))
+        strategy.reset(pose)
+        self.strategies[game] = strategy
+        self.estimators[game] = self.estimator_cls(
+            self.estimator_config, context, np.random.default_rng(streams["estimator"])
+        )
+        self.metrics[game] = TrackingMetrics(context.control_dt)
+
+    def sensed(self, state, games: np.ndarray, dt: float) -> None:
+        """The loop's estimation after a tick is sensed (``_sense``): each game's region
+        at the pursuer's pose and its estimator's belief from the detection (a reset at
+        tick 0)."""
+        grid, camera = self.context.grid, self.context.camera
+        for game in games.tolist():
+            pose = Pose(*state.poses[game, PURSUER].tolist())
+            detection = None
+            if state.detected[game]:
+                row = state.detection[game]
+                box = BoundingBox(
+                    float(row[BOX_X]), float(row[BOX_Y]), float(row[BOX_W]), float(row[BOX_H])
+                )
+                position = (float(row[SEEN_X]), float(row[SEEN_Y]))
+                detection = Detection(box=box, depth=float(row[DEPTH]), position=position)
+            region = VisibilityRegion(grid, pose, camera)
+            estimator = self.estimators[game]
+            if state.steps[game] == 0:
+                belief = estimator.reset(pose, detection, region)
+            else:
+                belief = estimator.update(dt, pose, detection, region)
+            self.seen[game] = (detection, region, belief)
+
+    def command(self, state, games: np.ndarray, time: np.ndarray, deciding: np.ndarray) -> None:
+        """The strategies' commands for ``games`` at ``time[k]`` s (deciding first where
+        ``deciding[k]``) into state.commands, and the tick's measures (``metrics.add``)."""
+        poses, commands = state.poses, state.commands
+        for k, game in enumerate(games.tolist()):
+            pursuer, evader = (
+                Pose(*poses[game, PURSUER].tolist()),
+                Pose(*poses[game, EVADER].tolist()),
+            )
+            detection, region, belief = self.seen[game]
+            observation = PursuerObservation(float(time[k]), pursuer, detection, belief, region)
+            strategy = self.strategies[game]
+            if deciding[k]:
+                strategy.decide(observation)
+            cmd = strategy.control(observation)
+            commands[game, PURSUER, 0], commands[game, PURSUER, 1] = cmd.v, cmd.w
+            detected, in_view = bool(state.detected[game]), bool(state.in_view[game])
+            self.metrics[game].add(pursuer, evader, detected, in_view, belief)
+
+
+def opponent_for(scenario, learner: str, bodies: np.ndarray, num_games: int):
+    """The opponent of ``learner`` ('pursuer' or 'evader') in ``scenario``'s games."""
+    role = "evader" if learner == "pursuer" else "pursuer"
+    cls, config = scenario.classes[role], scenario.configs[role]
+    settings = scenario.settings
+    decisions = -(-settings.ticks // settings.decide_every)
+    index = EVADER if role == "evader" else PURSUER
+    if cls in (RandomEvader, RandomPursuer) and config.model == "action":
+        return ActionTable(index, bodies[index], num_games, decisions)
+    if role == "evader":
+        return StrategyOpponent(cls, config, scenario.context, num_games)
+    estimator = (scenario.classes["estimator"], scenario.configs["estimator"])
+    return PursuerStrategyOpponent(cls, config, estimator, scenario.context, num_games)

@@ -1,0 +1,134 @@
+"""The batched game's data as its numba kernels take it: the fixed numbers of a game
+(:class:`World`, :class:`Rules`, built by :mod:`pegame.vector.game`) and the games'
+changing state (:class:`BatchState`, arrays whose first axis is the game), with the
+index constants of their columns. Units: SI, map frame.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+#: the roles' index in the role axes
+PURSUER, EVADER = 0, 1
+#: columns of ``rules.bodies``
+RADIUS, V_MAX, W_MAX, A_MAX, ALPHA_MAX = range(5)
+#: entries of ``rules.camera``
+FOV, NEAR, FAR, IMAGE_WIDTH, IMAGE_HEIGHT, FOCAL, DETECTION_RANGE, BODY_HEIGHT, CAMERA_HEIGHT = (
+    range(9)
+)
+#: columns of ``state.detection``: the box (px), the depth (m) and the map position (m)
+BOX_X, BOX_Y, BOX_W, BOX_H, DEPTH, SEEN_X, SEEN_Y = range(7)
+#: columns of ``state.tally`` (counts are exact in float64)
+(
+    TICKS,
+    DETECTED,
+    IN_VIEW,
+    IN_LOSS,
+    LOSS_START,
+    FIRST_LOSS,
+    LONGEST_LOSS,
+    REACQUISITIONS,
+    REACQUIRE_SUM,
+    REACQUIRE_MAX,
+    DISTANCE_SUM,
+    PURSUER_PATH,
+    EVADER_PATH,
+    LAST_PX,
+    LAST_PY,
+    LAST_EX,
+    LAST_EY,
+) = range(17)
+TALLY_SIZE = 17
+
+#: batches of at least this many games are spread over numba's threads (prange); below,
+#: starting the threads costs more than it saves, most of all on a busy machine
+PARALLEL_GAMES = 256
+
+
+class World(NamedTuple):
+    """The map as the kernels read it.
+
+    blocked: the grid's blocked cells; frame: its ``kernel_frame`` as a float64 array (a
+    tuple of mixed types cannot enter numba's parallel loops); masks: (2, H, W) the
+    grid inflated by the pursuer's and the evader's radius (the simulator's collision
+    masks); pooled, crop_x, crop_y, crop_frame: the crop's pooled map, robot-frame cell
+    offsets (m) and its map-to-cell numbers (:class:`pegame.envs.crop.LocalCrop`, float64);
+    crop_values: float32 (1 + H * W,): the crop's value off the map (1.0, blocked), then
+    the pooled map's cells flat (1.0 blocked, 0.0 free), the look-up table of the crop;
+    sight_values: bool (1 + H * W,): True (off the grid), then ``blocked`` flat, the
+    line of sight's look-up table;
+    extent: (x0, y0, 2 / width, 2 / height, diagonal) of the observations' normalisation.
+    """
+
+    blocked: np.ndarray
+    frame: np.ndarray
+    masks: np.ndarray
+    pooled: np.ndarray
+    crop_x: np.ndarray
+    crop_y: np.ndarray
+    crop_frame: np.ndarray
+    crop_values: np.ndarray
+    sight_values: np.ndarray
+    extent: np.ndarray
+
+
+class Rules(NamedTuple):
+    """The game's fixed numbers.
+
+    bodies: (2, 5) float64 per role (pursuer, evader): radius (m), v_max (m/s), w_max
+    (rad/s), a_max (m/s^2), alpha_max (rad/s^2); camera: float64 (9,) as the constants
+    FOV..CAMERA_HEIGHT; control_dt (s); substeps per control tick; decide_every: control
+    ticks per decision; ticks: control ticks per game.
+    """
+
+    bodies: np.ndarray
+    camera: np.ndarray
+    control_dt: float
+    substeps: int
+    decide_every: int
+    ticks: int
+
+
+class BatchState(NamedTuple):
+    """The games' state, first axis the game.
+
+    poses (N, 2, 3): (x, y, theta) per role; velocities (N, 2, 2): the current (v, w) of
+    bodies with acceleration limits; commands (N, 2, 2): this tick's (v, w) commands;
+    steps (N,): control ticks played; detected (N,): the current tick's detection;
+    detection (N, 7): its box, depth and position (columns BOX_X..SEEN_Y); in_view (N,);
+    seen (N, 3): time (s) and position of the last detection, for the pursuer's
+    observation, with has_seen (N,); tally (N, TALLY_SIZE): the metrics' running sums;
+    rewards (N,): detections counted in the current env step.
+    """
+
+    poses: np.ndarray
+    velocities: np.ndarray
+    commands: np.ndarray
+    steps: np.ndarray
+    detected: np.ndarray
+    detection: np.ndarray
+    in_view: np.ndarray
+    seen: np.ndarray
+    has_seen: np.ndarray
+    tally: np.ndarray
+    rewards: np.ndarray
+
+
+def new_state(num_games: int) -> BatchState:
+    """Zeroed state for ``num_games`` games."""
+    n = num_games
+    return BatchState(
+        np.zeros((n, 2, 3)),
+        np.zeros((n, 2, 2)),
+        np.zeros((n, 2, 2)),
+        np.zeros(n, np.int64),
+        np.zeros(n, np.bool_),
+        np.zeros((n, 7)),
+        np.zeros(n, np.bool_),
+        np.zeros((n, 3)),
+        np.zeros(n, np.bool_),
+        np.zeros((n, TALLY_SIZE)),
+        np.zeros(n),
+    )

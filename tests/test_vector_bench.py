@@ -1,0 +1,26 @@
+"""Smoke test of the batched env's benchmark on a few games (the figures themselves are
+measured by ``python -m pegame.bench``, never asserted here)."""
+
+from __future__ import annotations
+
+import math
+
+from pegame.envs.bench import bench_vector_env, format_vector
+
+
+def test_vector_bench_measures_every_figure_in_alternating_rounds():
+    report = bench_vector_env(
+        seconds=0.2, num_envs=6, smart_envs=2, overrides=["env=enclosed"], single_steps=20
+    )
+    assert report["rounds"] >= 1 and report["num_envs"] == 6
+    for key in (
+        "single_env_steps_per_s",
+        "vector_env_steps_per_s",
+        "vector_env_steps_per_s_all_cores",
+        "vector_env_steps_per_s_smart",
+        "vector_reset_ms_per_game",
+        "vector_env_array_bytes_per_game",
+    ):
+        assert math.isfinite(report[key]) and report[key] > 0, key
+    assert "6 games" in format_vector(report)
+    assert format_vector({}) == "batched env: -"

@@ -1,0 +1,203 @@
+"""The batched envs (pegame.envs.vector) play the single env's games: step by step against
+gymnasium's SyncVectorEnv of the single envs with the same seeds, through autoresets."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.vector import SyncVectorEnv
+
+from pegame.envs.parallel import parallel_env
+from pegame.envs.single import EvasionEnv, PursuitEnv
+from pegame.envs.vector import (
+    EvasionVectorEnv,
+    PursuitVectorEnv,
+    SelfPlayVectorEnv,
+    vector_env,
+)
+from pegame.errors import ConfigError
+
+#: short games on a paper map; a few steps more than one game, to cross an autoreset
+SHORT = ["env=enclosed", "game.t_max=2"]
+#: the measures of the estimator, which a batched game does not run
+ESTIMATION = ("mean_estimation_error", "n_eff_mean", "n_eff_min", "resamplings")
+
+
+def assert_infos_equal(batched: dict, synced: dict, path: str = "info") -> None:
+    assert sorted(batched) == sorted(synced), path
+    for key, value in synced.items():
+        if isinstance(value, dict):
+            assert_infos_equal(batched[key], value, f"{path}.{key}")
+        else:
+            got = np.asarray(batched[key])
+            assert got.dtype == value.dtype, f"{path}.{key}: {got.dtype} != {value.dtype}"
+            assert got.tolist() == value.tolist(), f"{path}.{key}"
+
+
+def play_side_by_side(batched, synced, seed: int, steps: int, rng) -> int:
+    """Step both envs with the same random actions; returns the games that ended."""
+    obs_b, info_b = batched.reset(seed=seed)
+    obs_s, info_s = synced.reset(seed=seed)
+    np.testing.assert_array_equal(obs_b, obs_s)
+    assert_infos_equal(info_b, info_s)
+    ended = 0
+    for _ in range(steps):
+        actions = rng.uniform(-1.0, 1.0, (batched.num_envs, 2)).astype(np.float32)
+        out_b, out_s = batched.step(actions), synced.step(actions)
+        for got, want in zip(out_b[:4], out_s[:4]):
+            np.testing.assert_array_equal(got, want)
+        assert_infos_equal(out_b[4], out_s[4])
+        ended += int(out_s[3].sum())
+    return ended
+
+
+@pytest.mark.parametrize(
+    ("opponent", "model"),
+    [("random", "action"), ("random", "waypoint"), ("smart", None)],
+)
+def test_pursuit_plays_the_single_envs_games(opponent, model):
+    overrides = SHORT + ([f"evader.model={model}"] if model else [])
+    n = 3
+    batched = vector_env(n, overrides=overrides, opponent=opponent, decision_period=0.2)
+    synced = SyncVectorEnv(
+        [
+            lambda: PursuitEnv(overrides=overrides, opponent=opponent, decision_period=0.2)
+            for _ in range(n)
+        ]
+    )
+    ended = play_side_by_side(batched, synced, seed=7, steps=14, rng=np.random.default_rng(0))
+    assert ended == n  # one game each ended, and the next ones played on identically
+
+
+def test_evasion_against_random_actions_plays_the_single_envs_games():
+    overrides = SHORT + ["pursuer.model=action"]
+    batched = vector_env(2, overrides=overrides, opponent="random", role="evader")
+    synced = SyncVectorEnv(
+        [lambda: EvasionEnv(overrides=overrides, opponent="random") for _ in range(2)]
+    )
+    rng = np.random.default_rng(1)
+    ended = 0
+    obs_b, _ = batched.reset(seed=3)
+    obs_s, _ = synced.reset(seed=3)
+    np.testing.assert_array_equal(obs_b, obs_s)
+    for _ in range(25):
+        actions = rng.uniform(-1.0, 1.0, (2, 2)).astype(np.float32)
+        out_b, out_s = batched.step(actions), synced.step(actions)
+        for got, want in zip(out_b[:4], out_s[:4]):
+            np.testing.assert_array_equal(got, want)
+        # The single env runs the estimator for the pursuer strategy, the batched one does
+        # not: every other measure is the same.
+        for key in ESTIMATION:
+            out_s[4].get("metrics", {}).pop(key, None)
+            out_s[4].get("metrics", {}).pop(f"_{key}", None)
+            out_b[4].get("metrics", {}).pop(key, None)
+            out_b[4].get("metrics", {}).pop(f"_{key}", None)
+        assert_infos_equal(out_b[4], out_s[4])
+        ended += int(out_s[3].sum())
+    assert ended == 2
+
+
+@pytest.mark.parametrize(("opponent", "model"), [("smart", None), ("random", "waypoint")])
+def test_evasion_against_pursuer_strategies_plays_the_single_envs_games(opponent, model):
+    """A pursuer strategy reads the belief: the batched game runs the estimator for it."""
+    overrides = SHORT + ([f"pursuer.model={model}"] if model else [])
+    batched = vector_env(2, overrides=overrides, opponent=opponent, role="evader")
+    synced = SyncVectorEnv(
+        [lambda: EvasionEnv(overrides=overrides, opponent=opponent) for _ in range(2)]
+    )
+    ended = play_side_by_side(batched, synced, seed=5, steps=22, rng=np.random.default_rng(3))
+    assert ended == 2
+
+
+def test_self_play_plays_the_parallel_envs_game():
+    batched = SelfPlayVectorEnv(1, overrides=SHORT)
+    single = parallel_env(overrides=SHORT)
+    obs_b, _ = batched.reset(seed=11)
+    obs_s, _ = single.reset(seed=11)
+    rng = np.random.default_rng(2)
+    for role in ("pursuer", "evader"):
+        np.testing.assert_array_equal(obs_b[role][0], obs_s[role])
+    for _ in range(20):
+        actions = {
+            role: rng.uniform(-1, 1, (1, 2)).astype(np.float32) for role in ("pursuer", "evader")
+        }
+        obs_b, rew_b, _, trunc_b, info_b = batched.step(actions)
+        obs_s, rew_s, _, trunc_s, info_s = single.step({r: a[0] for r, a in actions.items()})
+        for role in ("pursuer", "evader"):
+            np.testing.assert_array_equal(obs_b[role][0], obs_s[role])
+            assert rew_b[role][0] == rew_s[role]
+            assert trunc_b[role][0] == trunc_s[role]
+        assert info_b["tracking_rate"][0] == info_s["pursuer"]["tracking_rate"]
+        if trunc_s["pursuer"]:
+            assert {k: v[0] for k, v in info_b["metrics"].items() if not k.startswith("_")} == (
+                info_s["pursuer"]["metrics"]
+            )
+            break
+    else:
+        pytest.fail("the game did not end")
+
+
+def test_spaces_are_the_single_envs_batched():
+    env = vector_env(5, overrides=SHORT, opponent="random")
+    single = PursuitEnv(overrides=SHORT, opponent="random")
+    assert env.single_observation_space == single.observation_space
+    assert env.single_action_space == single.action_space
+    assert env.observation_space.shape == (5, *single.observation_space.shape)
+    assert env.action_space.shape == (5, 2)
+    obs, info = env.reset(seed=0)
+    assert obs in env.observation_space and info["_seed"].all()
+    assert info["seed"].tolist() == [0, 1, 2, 3, 4]
+    actions = env.action_space.sample()
+    stepped, *_ = env.step(actions)
+    assert stepped in env.observation_space
+    # As gymnasium's env checker asks of a single env: seeded resets are deterministic and
+    # the returned arrays are not reused by later calls.
+    again, _ = env.reset(seed=0)
+    np.testing.assert_array_equal(again, obs)
+    assert not np.shares_memory(again, obs)
+    np.testing.assert_array_equal(env.step(actions)[0], stepped)
+
+
+def test_gymnasium_vector_wrappers_run_on_it():
+    """Gymnasium 1.x ships no vector-env checker; its vector wrappers exercise the API
+    (spaces, step tuple, autoreset metadata, info masks)."""
+    env = gymnasium.wrappers.vector.RecordEpisodeStatistics(
+        vector_env(4, overrides=SHORT + ["evader.model=action"], opponent="random")
+    )
+    env.reset(seed=1)
+    episodes = 0
+    for _ in range(25):
+        *_, infos = env.step(env.action_space.sample())
+        if "episode" in infos:
+            episodes += int(infos["_episode"].sum())
+            assert (infos["episode"]["l"][infos["_episode"]] == 20).all()
+    assert episodes == 4
+
+
+def test_make_vec_builds_the_batched_env():
+    """gymnasium.make_vec uses the registered vector_entry_point: the batched env, which
+    plays the games of its "sync" mode (SyncVectorEnv of the single env)."""
+    kwargs = {"overrides": SHORT + ["evader.model=action"], "opponent": "random"}
+    batched = gymnasium.make_vec("pegame/Pursuit-v0", num_envs=3, **kwargs)
+    synced = gymnasium.make_vec(
+        "pegame/Pursuit-v0", num_envs=3, vectorization_mode="sync", **kwargs
+    )
+    assert isinstance(batched, PursuitVectorEnv) and isinstance(synced, SyncVectorEnv)
+    assert isinstance(gymnasium.make_vec("pegame/Evasion-v0", num_envs=2), EvasionVectorEnv)
+    assert play_side_by_side(batched, synced, 5, 25, np.random.default_rng(9)) == 3
+
+
+def test_bad_actions_and_unsupported_configs_are_clear_errors():
+    env = vector_env(2, overrides=SHORT + ["evader.model=action"], opponent="random")
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.zeros((2, 2), np.float32))
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"\[-1, 1\]"):
+        env.step(np.full((2, 2), 2.0, np.float32))
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros((3, 2), np.float32))
+    with pytest.raises(ConfigError, match="detector.miss_probability"):
+        vector_env(2, overrides=SHORT + ["detector.miss_probability=0.1"])
+    with pytest.raises(ConfigError, match="role"):
+        vector_env(2, overrides=SHORT, role="referee")

@@ -1,0 +1,180 @@
+"""The batched game's kernels (pegame.vector) against the plain code they reproduce, bit for
+bit: Python's hypot and angle wrap, the crop, the in-view tests and the simulator's move."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pegame.envs.crop import local_crop_reference
+from pegame.envs.vector import vector_env
+from pegame.sims.grid import _Agent
+from pegame.types import Pose, Velocity, wrap_angle
+from pegame.vector import camera as batched_camera
+from pegame.vector import exact, kernels
+from pegame.vector.features import crop_into
+from pegame.vector.state import new_state
+from pegame.visibility import body_in_view, in_view
+from pegame.visibility.sight import _segment_clear
+
+
+@pytest.fixture(scope="module")
+def game():
+    env = vector_env(1, overrides=["env=hall", "evader.model=action"], opponent="random")
+    env.reset(seed=0)
+    return env.game
+
+
+def test_hypot_is_pythons_bit_for_bit():
+    rng = np.random.default_rng(0)
+    pairs = rng.uniform(-20.0, 20.0, (20000, 2))
+    pairs[:200] *= 1e-300
+    pairs[200:400] *= 1e300
+    specials = [(0.0, 0.0), (-0.0, 3.0), (math.inf, 1.0), (1.0, -math.inf), (3.0, 4.0)]
+    for x, y in [*pairs.tolist(), *specials]:
+        assert exact.hypot(x, y) == math.hypot(x, y), (x, y)
+    assert math.isnan(exact.hypot(math.nan, 1.0))
+
+
+def test_wrap_angle_is_pegames_bit_for_bit():
+    rng = np.random.default_rng(1)
+    angles = rng.uniform(-12.0, 12.0, 20000).tolist()
+    pi = math.pi
+    edges = [pi, -pi, 3 * pi, -3 * pi, 2 * pi, 0.0, -0.0, 1e4, -1e4]
+    edges += [math.nextafter(a, b) for a in (pi, -pi, 3 * pi, -3 * pi) for b in (0.0, 10.0)]
+    for angle in angles + edges:
+        assert exact.wrap_angle(angle) == wrap_angle(angle), angle
+
+
+def test_crop_is_the_reference_crop(game):
+    world, grid = game.world, game.context.grid
+    settings = game.settings
+    rng = np.random.default_rng(2)
+    x0, x1, y0, y1 = grid.extent
+    out = np.empty(settings.crop_cells**2, np.float32)
+    cells = np.empty(settings.crop_cells**2, np.int64)
+    for x, y, theta in zip(
+        rng.uniform(x0 - 2, x1 + 2, 200), rng.uniform(y0 - 2, y1 + 2, 200), rng.uniform(-4, 4, 200)
+    ):
+        crop_into(world, x, y, theta, out, 0, cells)
+        want = local_crop_reference(
+            grid, x, y, theta, settings.crop_cells, settings.crop_resolution
+        ).ravel()
+        np.testing.assert_array_equal(out, want)
+
+
+def test_crop_on_cell_edges_is_the_reference_crop(game):
+    """Poses whose crop cells fall on map cell edges (headings along the axes, positions on
+    the map's lattice and one ulp off it) take the division route and still give the
+    reference crop; random poses take the multiplication route."""
+    world, grid = game.world, game.context.grid
+    settings = game.settings
+    res, (gx, gy, _) = grid.resolution, grid.origin
+    out = np.empty(settings.crop_cells**2, np.float32)
+    cells = np.empty(settings.crop_cells**2, np.int64)
+    rng = np.random.default_rng(7)
+    height, width = grid.blocked.shape
+    slow = []
+    headings = [0.0, math.pi / 2, math.pi, -math.pi / 2, -0.0, math.nextafter(0.0, 1.0)]
+    for i in range(300):
+        row, col = rng.integers(-5, height + 5), rng.integers(-5, width + 5)
+        x, y = gx + col * res, gy + row * res
+        if i % 3:
+            x = math.nextafter(x, math.inf if i % 3 == 1 else -math.inf)
+        theta = headings[i % len(headings)]
+        slow.append(crop_into(world, x, y, theta, out, 0, cells))
+        want = local_crop_reference(
+            grid, x, y, theta, settings.crop_cells, settings.crop_resolution
+        ).ravel()
+        np.testing.assert_array_equal(out, want)
+    assert np.mean(slow) > 0.9
+    x0, x1, y0, y1 = grid.extent
+    fast = [
+        not crop_into(world, x, y, theta, out, 0, cells)
+        for x, y, theta in zip(
+            rng.uniform(x0, x1, 100), rng.uniform(y0, y1, 100), rng.uniform(-4, 4, 100)
+        )
+    ]
+    assert np.mean(fast) > 0.9
+
+
+def test_in_view_tests_are_the_visibility_functions(game):
+    world, grid, camera = game.world, game.context.grid, game.context.camera
+    numbers = game.rules.camera
+    rng = np.random.default_rng(3)
+    free = np.argwhere(~grid.blocked)
+    seen = 0
+    for _ in range(3000):
+        (r, c), (r2, c2) = free[rng.integers(len(free), size=2)]
+        px, py = grid.cell_to_world(r, c)
+        ex, ey = grid.cell_to_world(r2, c2)
+        ex, ey = ex + rng.uniform(-0.5, 0.5), ey + rng.uniform(-0.5, 0.5)
+        theta = math.atan2(ey - py, ex - px) + rng.uniform(-0.7, 0.7)
+        pose = Pose(px, py, theta)
+        centre = in_view(grid, camera, pose, (ex, ey))
+        assert batched_camera.point_in_view(world, numbers, px, py, theta, ex, ey) == centre
+        body = batched_camera.body_in_view(world, numbers, px, py, theta, ex, ey, 0.25, centre)
+        assert body == body_in_view(grid, camera, pose, (ex, ey), 0.25)
+        seen += centre
+    assert 100 < seen < 2900  # both outcomes were tested
+
+
+def test_segment_clear_on_cell_edges_is_the_sight_kernel(game):
+    """Segments along the map's lattice lines (their samples on cell edges: the division
+    route) and random ones (the product route) give _segment_clear's answer."""
+    world, grid = game.world, game.context.grid
+    res, (gx, gy, _) = grid.resolution, grid.origin
+    height, width = grid.blocked.shape
+    rng = np.random.default_rng(8)
+    clear = []
+    for i in range(2000):
+        (r, c), (r2, c2) = rng.integers(-3, [height + 3, width + 3], (2, 2))
+        if i % 2:
+            r2 = r  # along a lattice line
+        ax, ay, bx, by = gx + c * res, gy + r * res, gx + c2 * res, gy + r2 * res
+        if i % 4 == 3:
+            ax, ay = ax + rng.uniform(0, res), ay + rng.uniform(0, res)
+        want = _segment_clear(grid.blocked, ax, ay, bx, by, 0.5 * res, grid.kernel_frame)
+        assert batched_camera.segment_clear(world, ax, ay, bx, by, 0.5 * res) == want
+        clear.append(want)
+    assert 0.05 < np.mean(clear) < 0.95  # both outcomes were tested
+
+
+@pytest.mark.parametrize("a_max", [math.inf, 0.8])
+def test_move_is_the_grid_simulators(game, a_max):
+    grid, context = game.context.grid, game.context
+    body = context.pursuer.__class__(context.pursuer.radius, 0.5, 1.8, a_max, 2 * a_max)
+    agent = _Agent(grid, body)
+    rules = game.rules._replace(bodies=np.array([[body.radius, 0.5, 1.8, a_max, 2 * a_max]] * 2))
+    state = new_state(1)
+    world = game.world._replace(masks=np.stack([agent.blocked, agent.blocked]))
+    rng = np.random.default_rng(4)
+    free = np.argwhere(~agent.blocked)
+    r, c = free[len(free) // 2]
+    x, y = grid.cell_to_world(r, c)
+    agent.pose = Pose(x, y, 0.3)
+    state.poses[0, 0] = (x, y, 0.3)
+    for _ in range(600):  # long enough to run into walls
+        v, w = rng.uniform(-0.7, 0.7), rng.uniform(-2.5, 2.5)
+        agent.move(Velocity(v, w), 0.1)
+        state.commands[0, 0] = (v, w)
+        kernels.move(world, rules, state, 0, 0, 0.1)
+        assert tuple(state.poses[0, 0]) == (agent.pose.x, agent.pose.y, agent.pose.theta)
+        if agent.limited:
+            assert tuple(state.velocities[0, 0]) == (agent.velocity.v, agent.velocity.w)
+
+
+def test_hypot_shortcuts_answer_as_the_exact_hypot():
+    rng = np.random.default_rng(5)
+    res = 0.05
+    pairs = rng.uniform(-0.1, 0.1, (20000, 2)).tolist()
+    # Lengths on the edges: whole numbers of half cells, and the camera's range limits.
+    for length in (0.025, 0.05, 0.075, 0.3, 5.0):
+        angles = rng.uniform(-math.pi, math.pi, 2000)
+        pairs += np.column_stack([length * np.cos(angles), length * np.sin(angles)]).tolist()
+    for x, y in pairs:
+        assert exact.ceil_of_hypot(x, y, res) == math.ceil(2 * math.hypot(x, y) / res)
+        assert exact.hypot_within(x, y, 0.3, 5.0) == (0.3 <= math.hypot(x, y) <= 5.0)
+        assert exact.hypot_within(x, y, 0.025, 0.075) == (0.025 <= math.hypot(x, y) <= 0.075)
