@@ -1,16 +1,19 @@
 #!/usr/bin/env bash
-# The team study (docs/teams/README.md): conf/experiment/teams.yaml swept in two halves
-# (1 and 2 evaders, run side by side on a 2-core machine), then the report with the paired
-# comparison of the cooperative team against independent smart pursuers.
+# The team study (docs/teams/README.md): conf/experiment/teams.yaml swept in three parts run
+# side by side (office; brick; enclosed and hall), then the report with the paired
+# comparison of the cooperative team against independent copies of the smart pursuer.
 # Writes the games into $OUT (default outputs/teams) and the report into docs/teams/report.
+# N games per cell (seeds 0 .. N-1, shared by every cell).
 set -euo pipefail
 OUT=${OUT:-outputs/teams}
-N=${N:-40}
+N=${N:-20}
 PY=${PY:-python}
-for m in 1 2; do
-  $PY -m pegame -m +experiment=teams game.trials="$N" team.evaders=$m \
-    hydra.launcher.n_jobs=1 hydra.sweep.dir="$OUT/evaders$m" &
+part=0
+for maps in office brick enclosed,hall; do
+  part=$((part + 1))
+  $PY -m pegame -m +experiment=teams game.trials="$N" env=$maps team.evaders=1,2 \
+    hydra.launcher.n_jobs=1 hydra.sweep.dir="$OUT/part$part" &
 done
 wait
-$PY -m pegame.report "$OUT"/evaders1 "$OUT"/evaders2 --out docs/teams/report \
-  --compare pursuer=smart,cooperative
+$PY -m pegame.report "$OUT"/part1 "$OUT"/part2 "$OUT"/part3 --out docs/teams/report \
+  --compare pairing=S-S,cooperative-S
