@@ -5,8 +5,8 @@ A *factor* is a setting that differs between a sweep's configurations (see
 every cell of the paper's layout (environment x speed ratio v_p/v_e x pairing, and each
 combination of the sweep's *other* factors) where both values A and B of the factor have
 games (the factor may also be one of the paper's axes, e.g. ``pairing=S-S,cooperative-S``
-for two pursuers in otherwise equal cells), and compares B against A on the seeds they share (same seed, same spawn poses):
-n pairs, the mean of each side on those seeds, the mean difference B - A with its
+for two pursuers in otherwise equal cells), and compares B against A on the seeds they
+share (same seed, same spawn poses): n pairs, the mean of each side on those seeds, the mean difference B - A with its
 percentile-bootstrap CI over seeds, the rank-biserial correlation, and the two-sided
 Wilcoxon signed-rank test (Pratt's zeros, see :mod:`pegame.report.paired`),
 Holm-Bonferroni corrected across the comparison's tested cells. Rates are fractions in
