@@ -307,3 +307,14 @@ def test_the_team_evader_hides_from_the_nearest_pursuer_of_each_candidate(solo):
     goal = tuple(evader.search.centres[alone.cell])
     guarded = evader.team_escape(me, (a, Pose(goal[0], goal[1], math.pi)))
     assert guarded.cell != alone.cell
+
+
+def test_a_team_recording_shows_every_agent_fov_and_belief(tmp_path):
+    from rerun.chunk import RrdReader
+
+    game = team_game("recorder=rerun", "game.t_max=3", "team.pursuers=3", "team.evaders=2")
+    game.play(tmp_path, "team")
+    paths = {chunk.entity_path for chunk in RrdReader(tmp_path / "team.rrd").stream().to_chunks()}
+    for member in ("pursuer_1/pose", "pursuer_2/fov", "evader_1/pose", "belief_1/mean"):
+        assert f"/world/{member}" in paths
+    assert "/world/pursuer/pose" in paths and "/world/belief/mean" in paths
