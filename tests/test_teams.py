@@ -318,3 +318,20 @@ def test_a_team_recording_shows_every_agent_fov_and_belief(tmp_path):
     for member in ("pursuer_1/pose", "pursuer_2/fov", "evader_1/pose", "belief_1/mean"):
         assert f"/world/{member}" in paths
     assert "/world/pursuer/pose" in paths and "/world/belief/mean" in paths
+
+
+def test_the_trajectory_figure_draws_every_member_of_a_team(tmp_path):
+    from pegame.figures import agents, plot_trajectory
+
+    game = team_game("team.pursuers=2", "team.evaders=3", "game.t_max=2")
+    outcome = game.play(tmp_path)
+    path = plot_trajectory(
+        game.context.grid, outcome.trajectory, tmp_path / "t.png", header=outcome.header
+    )
+    assert path.stat().st_size > 0
+    labels = [label for label, _, _ in agents(outcome.header)]
+    assert labels == ["pursuer 0", "pursuer 1", "evader 0", "evader 1", "evader 2"]
+    assert [label for label, _, _ in agents(team_header(1, 1)[:2] + ("pursuer_x", "evader_x"))] == [
+        "pursuer",
+        "evader",
+    ]
