@@ -335,3 +335,20 @@ def test_the_trajectory_figure_draws_every_member_of_a_team(tmp_path):
         "pursuer",
         "evader",
     ]
+
+
+def test_the_pettingzoo_env_plays_teams_and_passes_the_parallel_api_test():
+    from pettingzoo.test import parallel_api_test
+
+    from pegame.envs import parallel_env
+
+    overrides = ["env=hall", "game.t_max=4", "team.pursuers=2", "team.evaders=2"]
+    env = parallel_env(overrides=overrides, decision_period=1.0)
+    assert env.possible_agents == ["pursuer_0", "pursuer_1", "evader_0", "evader_1"]
+    parallel_api_test(env, num_cycles=5)
+    env.reset(seed=1)
+    actions = {agent: np.zeros(2, dtype=np.float32) for agent in env.agents}
+    _, rewards, _, _, _ = env.step(actions)
+    assert (
+        rewards["pursuer_0"] == rewards["pursuer_1"] == -(rewards["evader_0"] + rewards["evader_1"])
+    )
