@@ -82,7 +82,7 @@ __all__ = [
 
 @dataclass(frozen=True, eq=False)
 class PursuerTeam:
-    """What a pursuer knows of its team at one tick (a 1v1 game is a team of one).
+    """What a pursuer knows of its team at one tick (a team game's; None in a 1v1 game).
 
     member: this pursuer's index i among the N pursuers; target: the index of the evader
     its observation's own fields describe (i mod M); pursuers: the N pursuers' true poses;
@@ -113,7 +113,7 @@ class PursuerObservation:
     In a team game these fields are the pursuer's own (its pose, its region) about its
     target evader (its own detection of it, the team's belief about it), so a 1v1
     strategy plays as one of N independent copies; team: the whole team's view
-    (:class:`PursuerTeam`), for strategies that cooperate.
+    (:class:`PursuerTeam`), for strategies that cooperate (None in a 1v1 game).
     """
 
     time: float
@@ -198,7 +198,7 @@ class TeamTick:
     regions: each pursuer's visibility region (None when not computed); in_view[i][j]:
     ground truth, evader j's body in pursuer i's view; pursuer_commands,
     evader_commands: the velocities applied after this tick; pursuer_plans,
-    evader_plans: the latest plans.
+    evader_plans: the latest plans. (A 1v1 game's ticks have ``team`` None.)
     """
 
     pursuers: tuple[Pose, ...]

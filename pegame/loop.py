@@ -204,7 +204,7 @@ class TickLoop:
     @property
     def in_view(self) -> bool:
         """Ground truth: evader 0's body in the view of some pursuer at the current tick."""
-        return any(row[0] for row in self.in_views)
+        return self.in_views[0][0] if self.solo else any(row[0] for row in self.in_views)
 
     @property
     def plans(self) -> tuple[Plan, Plan]:
@@ -239,19 +239,16 @@ class TickLoop:
     def _sense(self, regions: tuple[VisibilityRegion, ...] | None = None) -> None:
         """The current tick's poses, frames, detections, regions, beliefs and in_view;
         ``regions``: the pursuers' regions already built for their current poses, if any."""
+        if self.solo:
+            self._sense_one(regions)
+            return
         grid, camera, radius = self.context.grid, self.context.camera, self.context.evader.radius
         self.pursuers, self.evaders = self.sim.team_poses
         self.frames: tuple[SensorFrame, ...] = self.sim.sense_team(self.time)
-        if self.solo:
-            self.detections = ((self.detectors[0][0].detect(self.frames[0]),),)
-        else:
-            self.detections = tuple(
-                tuple(
-                    _identified(detector.detect(frame.about(j)), j)
-                    for j, detector in enumerate(row)
-                )
-                for frame, row in zip(self.frames, self.detectors)
-            )
+        self.detections = tuple(
+            tuple(_identified(detector.detect(frame.about(j)), j) for j, detector in enumerate(row))
+            for frame, row in zip(self.frames, self.detectors)
+        )
         self.regions = (None,) * self.n_pursuers
         self.union = None
         self.beliefs: tuple[Belief, ...] = (EMPTY_BELIEF,) * self.n_evaders
@@ -265,6 +262,27 @@ class TickLoop:
             tuple(body_in_view(grid, camera, p, (e.x, e.y), radius) for e in self.evaders)
             for p in self.pursuers
         )
+
+    def _sense_one(self, regions: tuple[VisibilityRegion, ...] | None) -> None:
+        """:meth:`_sense` of a 1v1 game through the simulator's and estimator's 1v1
+        methods: the same tick, without the team's per-member loops (a 1v1 game's ticks
+        are the most played; this keeps them as fast as before teams)."""
+        grid, camera = self.context.grid, self.context.camera
+        pursuer, evader = self.sim.poses
+        frame = self.sim.sense(self.time)
+        detection = self.detectors[0][0].detect(frame)
+        region, belief = None, EMPTY_BELIEF
+        if self.estimate:
+            region = regions[0] if regions else VisibilityRegion(grid, pursuer, camera)
+            estimator = self.estimators[0]
+            if self.step == 0:
+                belief = estimator.reset(pursuer, detection, region)
+            else:
+                belief = estimator.update(self.context.control_dt, pursuer, detection, region)
+        seen = body_in_view(grid, camera, pursuer, (evader.x, evader.y), self.context.evader.radius)
+        self.pursuers, self.evaders, self.frames = (pursuer,), (evader,), (frame,)
+        self.detections, self.regions, self.union = ((detection,),), (region,), region
+        self.beliefs, self.in_views = (belief,), ((seen,),)
 
     def _estimate(self, j: int) -> Belief:
         """Evader j's estimator, reset at tick 0 and updated after, by every pursuer."""
@@ -282,9 +300,11 @@ class TickLoop:
     def pursuer_observation(self, i: int = 0) -> PursuerObservation:
         """What pursuer ``i`` is given at this tick (needs ``estimate``)."""
         j = i % self.n_evaders
-        team = PursuerTeam(
-            i, j, self.pursuers, self.detections, self.beliefs, self.regions, self.union
-        )
+        team = None
+        if not self.solo:
+            team = PursuerTeam(
+                i, j, self.pursuers, self.detections, self.beliefs, self.regions, self.union
+            )
         return PursuerObservation(
             self.time,
             self.pursuers[i],
@@ -379,7 +399,9 @@ class TickLoop:
             in_view,
             (p_cmds[0], e_cmds[0]),
             (self.pursuer_plans[0], self.evader_plans[0]),
-            TeamTick(
+            None
+            if self.solo
+            else TeamTick(
                 self.pursuers,
                 self.evaders,
                 self.frames,
@@ -409,13 +431,21 @@ class TickLoop:
         """Hold the commands for one control period, in ``substeps`` simulator steps; a
         role without commands is paused (``evader_first``'s turns)."""
         dt = self.context.control_dt / self.substeps
+        sim = self.sim
         for _ in range(self.substeps):
-            if pursuers is not None and evaders is not None:
-                self.sim.step_team(pursuers, evaders, dt)
+            if self.solo:  # the simulator's 1v1 methods, as before teams
+                if pursuers is not None and evaders is not None:
+                    sim.step(pursuers[0], evaders[0], dt)
+                elif pursuers is not None:
+                    sim.step_one("pursuer", pursuers[0], dt)
+                elif evaders is not None:
+                    sim.step_one("evader", evaders[0], dt)
+            elif pursuers is not None and evaders is not None:
+                sim.step_team(pursuers, evaders, dt)
             elif pursuers is not None:
-                self.sim.step_team_one("pursuer", pursuers, dt)
+                sim.step_team_one("pursuer", pursuers, dt)
             elif evaders is not None:
-                self.sim.step_team_one("evader", evaders, dt)
+                sim.step_team_one("evader", evaders, dt)
 
 
 def _identified(detection: Detection | None, evader: int) -> Detection | None:
