@@ -318,7 +318,7 @@ class TickLoop:
         """What evader ``j`` is given at this tick: the pursuer nearest to it and the
         union of the pursuers' regions."""
         me = self.evaders[j]
-        near = nearest(self.pursuers, me)
+        near = 0 if self.n_pursuers == 1 else nearest(self.pursuers, me)
         return EvaderObservation(self.time, me, self.pursuers[near], self.union, self.pursuers, j)
 
     def advance(self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None = None) -> Tick:
@@ -328,8 +328,9 @@ class TickLoop:
         if self.done:
             raise RuntimeError("The game is over: every tick has been played.")
         commanded: dict[str, list[Velocity]] = {}
-        for role, command in (commands or {}).items():
-            commanded[role] = [command] if isinstance(command, Velocity) else list(command)
+        if commands:
+            for role, command in commands.items():
+                commanded[role] = [command] if isinstance(command, Velocity) else list(command)
         missing = [role for role in self.external if role not in commanded]
         if missing:
             raise ValueError(f"No command for the external role(s) {missing}.")
@@ -369,7 +370,7 @@ class TickLoop:
         if e_obs is not None:
             commanded["evader"] = [s.control(o) for s, o in zip(evaders, e_obs)]
         p_cmds, e_cmds = commanded["pursuer"], commanded["evader"]
-        in_view = self.in_view
+        in_view = self.in_views[0][0] if self.solo else self.in_view
         if self.solo:
             self.metrics.add(
                 self.pursuers[0],
