@@ -89,6 +89,12 @@ def weighted_kmeans(
     return c, np.bincount(label, weights, minlength=len(c))
 
 
+def alone(observation: PursuerObservation) -> PursuerTeam:
+    """The team of one of a 1v1 game's pursuer (whose observation has no team view)."""
+    o = observation
+    return PursuerTeam(0, 0, (o.pose,), ((o.detection,),), (o.belief,), (o.region,), o.region)
+
+
 @dataclass(frozen=True)
 class Task:
     """A place for a free pursuer: ``goal`` (x, y) m, its ``value`` (> 0), the evader it
@@ -251,9 +257,7 @@ class CooperativePursuer(SmartPursuer):
     # -- the strategy
 
     def decide(self, observation: PursuerObservation) -> Plan:
-        team = observation.team
-        if team is None:
-            return super().decide(observation)
+        team = observation.team or alone(observation)
         tracked = self.trackers(team).get(team.member)
         if tracked is not None:
             self.tracking, self.task = tracked, None
@@ -280,9 +284,7 @@ class CooperativePursuer(SmartPursuer):
         return Plan(goal=task.goal, path=result.path, info=info)
 
     def control(self, observation: PursuerObservation) -> Velocity:
-        team = observation.team
-        if team is None:
-            return super().control(observation)
+        team = observation.team or alone(observation)
         row = team.detections[team.member]
         tracked = self.trackers(team).get(team.member)
         if tracked is not None:
