@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 
 import numpy as np
@@ -64,16 +65,40 @@ __all__ = [
     "Pose",
     "Pursuer",
     "PursuerObservation",
+    "PursuerTeam",
     "Recorder",
     "Region",
     "SensorFrame",
     "Simulator",
     "Strategy",
+    "TeamTick",
     "Tick",
     "Velocity",
     "clamp",
+    "fuse_detections",
     "wrap_angle",
 ]
+
+
+@dataclass(frozen=True, eq=False)
+class PursuerTeam:
+    """What a pursuer knows of its team at one tick (a team game's; None in a 1v1 game).
+
+    member: this pursuer's index i among the N pursuers; target: the index of the evader
+    its observation's own fields describe (i mod M); pursuers: the N pursuers' true poses;
+    detections: detections[i][j] is pursuer i's detection of evader j this tick, or None;
+    beliefs: the team's belief about each of the M evaders (one estimator per evader,
+    fed by every pursuer's detections and the union of their regions); regions: the N
+    pursuers' visibility regions; union: the cells at least one of them sees.
+    """
+
+    member: int
+    target: int
+    pursuers: tuple[Pose, ...]
+    detections: tuple[tuple[Detection | None, ...], ...]
+    beliefs: tuple[Belief, ...]
+    regions: tuple[Region, ...]
+    union: Region
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,6 +109,11 @@ class PursuerObservation:
     the evader this tick, or None; belief: the estimator's current belief; region: the
     pursuer's own visibility region this tick (``region.mask`` is a bool (H, W) mask over
     the grid, computed when first read).
+
+    In a team game these fields are the pursuer's own (its pose, its region) about its
+    target evader (its own detection of it, the team's belief about it), so a 1v1
+    strategy plays as one of N independent copies; team: the whole team's view
+    (:class:`PursuerTeam`), for strategies that cooperate (None in a 1v1 game).
     """
 
     time: float
@@ -91,6 +121,7 @@ class PursuerObservation:
     detection: Detection | None
     belief: Belief
     region: Region
+    team: PursuerTeam | None = None
 
 
 @dataclass(frozen=True)
@@ -100,12 +131,19 @@ class EvaderObservation:
     pursuer_region: the pursuer's visibility region at this tick, as the game computed it
     from the pursuer's pose, the map and the camera (which the evader knows too, so this
     only saves it the work); None when the game did not compute it.
+
+    Against a team: pursuer is the pursuer nearest to this evader and pursuer_region the
+    union of every pursuer's region (:class:`pegame.visibility.UnionRegion`), so a 1v1
+    strategy hides from the whole team; pursuers: every pursuer's pose (one in 1v1);
+    member: this evader's index j among the M evaders.
     """
 
     time: float
     pose: Pose
     pursuer: Pose
     pursuer_region: Region | None = None
+    pursuers: tuple[Pose, ...] = ()
+    member: int = 0
 
 
 @dataclass(frozen=True)
@@ -146,6 +184,34 @@ class Tick:
     in_view: bool
     commands: tuple[Velocity, Velocity]
     plans: tuple[Plan, Plan]
+    team: TeamTick | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class TeamTick:
+    """Every member's part of one control tick (the :class:`Tick`'s own fields are
+    pursuer 0's and evader 0's: its detection and belief of evader 0, and in_view whether
+    any pursuer has evader 0 in view).
+
+    pursuers (N) and evaders (M): true poses; frames: each pursuer's sensor frame;
+    detections[i][j]: pursuer i's detection of evader j or None; beliefs: one per evader;
+    regions: each pursuer's visibility region (None when not computed); in_view[i][j]:
+    ground truth, evader j's body in pursuer i's view; pursuer_commands,
+    evader_commands: the velocities applied after this tick; pursuer_plans,
+    evader_plans: the latest plans. (A 1v1 game's ticks have ``team`` None.)
+    """
+
+    pursuers: tuple[Pose, ...]
+    evaders: tuple[Pose, ...]
+    frames: tuple[SensorFrame, ...]
+    detections: tuple[tuple[Detection | None, ...], ...]
+    beliefs: tuple[Belief, ...]
+    regions: tuple[Region | None, ...]
+    in_view: tuple[tuple[bool, ...], ...]
+    pursuer_commands: tuple[Velocity, ...]
+    evader_commands: tuple[Velocity, ...]
+    pursuer_plans: tuple[Plan, ...]
+    evader_plans: tuple[Plan, ...]
 
 
 # ----------------------------------------------------------------------- interfaces
@@ -171,7 +237,41 @@ class Plugin(ABC):  # noqa: B024 - an abstract base for the interfaces, which ad
 
 
 class Simulator(Plugin):
-    """Holds the true state of both agents and renders the pursuer's sensor."""
+    """Holds the true state of both agents and renders the pursuer's sensor.
+
+    Teams: a simulator that can hold N pursuers and M evaders sets ``teams = True`` and
+    overrides the ``*_team`` methods; the defaults below play the 1v1 methods, for one
+    pursuer and one evader (the tick loop calls only the team methods).
+    """
+
+    #: whether the ``*_team`` methods hold more than one pursuer or evader
+    teams: ClassVar[bool] = False
+
+    def reset_team(self, pursuers: Sequence[Pose], evaders: Sequence[Pose]) -> None:
+        """Place N pursuers and M evaders (map frame); the default plays :meth:`reset`."""
+        if len(pursuers) != 1 or len(evaders) != 1:
+            raise NotImplementedError(f"{type(self).__name__} plays one pursuer and one evader.")
+        self.reset(pursuers[0], evaders[0])
+
+    def step_team(
+        self, pursuer_cmds: Sequence[Velocity], evader_cmds: Sequence[Velocity], dt: float
+    ) -> None:
+        """:meth:`step` for every agent (commands in member order)."""
+        self.step(pursuer_cmds[0], evader_cmds[0], dt)
+
+    def step_team_one(self, role: str, cmds: Sequence[Velocity], dt: float) -> None:
+        """:meth:`step_one` for every agent of ``role``, the other role paused."""
+        self.step_one(role, cmds[0], dt)
+
+    @property
+    def team_poses(self) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
+        """The true poses of the (pursuers, evaders), in member order."""
+        pursuer, evader = self.poses
+        return (pursuer,), (evader,)
+
+    def sense_team(self, time: float) -> tuple[SensorFrame, ...]:
+        """Each pursuer camera's frame at ``time`` (s), in member order."""
+        return (self.sense(time),)
 
     @abstractmethod
     def reset(self, pursuer: Pose, evader: Pose) -> None:
@@ -204,7 +304,17 @@ class Simulator(Plugin):
 
 
 class Detector(Plugin):
-    """Turns a sensor frame into a detection of the evader, or None."""
+    """Turns a sensor frame into a detection of the evader, or None.
+
+    In a team game the loop holds one detector per (pursuer, evader) pair and asks the
+    one of pair (i, j) about pursuer i's frame with ``frame.evader_truth`` = evader j.
+    ``identifies``: whether a detection then is of evader j only (a simulator-side
+    detector reading ``evader_truth``); a detector that finds whoever is in its images
+    cannot tell evaders apart and plays only against one evader.
+    """
+
+    #: whether detect() reports only the evader of ``frame.evader_truth``
+    identifies: ClassVar[bool] = False
 
     @abstractmethod
     def detect(self, frame: SensorFrame) -> Detection | None:
@@ -233,6 +343,46 @@ class Estimator(Plugin):
         absence) and the pursuer's visibility region (``region.mask`` is a bool (H, W) mask
         over the grid; ``region.holds(cells)`` answers for a few cells, at a fraction of
         the cost)."""
+
+    def reset_team(
+        self, pursuers: Sequence[Pose], detections: Sequence[Detection | None], region: Region
+    ) -> Belief:
+        """:meth:`reset` for a team: every pursuer's pose and detection of this
+        estimator's evader, and the union of their regions. The default fuses the
+        detections (:func:`fuse_detections`) and plays :meth:`reset`."""
+        pursuer, detection = fuse_detections(pursuers, detections)
+        return self.reset(pursuer, detection, region)
+
+    def update_team(
+        self,
+        dt: float,
+        pursuers: Sequence[Pose],
+        detections: Sequence[Detection | None],
+        region: Region,
+    ) -> Belief:
+        """:meth:`update` for a team (arguments as :meth:`reset_team`): the default fuses
+        the detections and plays :meth:`update` with the union region, so the negative
+        information is every pursuer's."""
+        pursuer, detection = fuse_detections(pursuers, detections)
+        return self.update(dt, pursuer, detection, region)
+
+
+def fuse_detections(
+    pursuers: Sequence[Pose], detections: Sequence[Detection | None]
+) -> tuple[Pose, Detection | None]:
+    """One detection from several pursuers' detections of the same evader, and the pose
+    of the pursuer it is credited to: the nearest detection (smallest depth, the least
+    noisy) placed at the mean of all the detected positions (m, map frame), the fusion
+    of equally trusted measurements of one point. (pursuers[0], None) when none detects."""
+    seen = [(d.depth, i, d) for i, d in enumerate(detections) if d is not None]
+    if not seen:
+        return pursuers[0], None
+    _, nearest, best = min(seen, key=lambda s: s[:2])
+    if len(seen) == 1:
+        return pursuers[nearest], best
+    xs = [d.position[0] for _, _, d in seen]
+    ys = [d.position[1] for _, _, d in seen]
+    return pursuers[nearest], replace(best, position=(sum(xs) / len(xs), sum(ys) / len(ys)))
 
 
 class Strategy(Plugin):

@@ -5,7 +5,8 @@ is multi-threaded), measured together so that ratios between figures are meaning
 machine. Numba kernels are compiled (or loaded from cache) by a warm-up call first; the
 first-call cost is reported separately as ``jit_warmup_s``. Keys whose piece does not exist
 yet are null. Figures taken on each paper map are under ``maps``; the top-level key is the
-worst map's (the most ms, the fewest S-S games per second).
+worst map's (the most ms, the fewest S-S games per second). ``team_game_s`` is the cost of
+a game by team size (N pursuers v M evaders).
 """
 
 from __future__ import annotations
@@ -121,6 +122,27 @@ def games_per_second(overrides: list[str], games: int, out_dir: str) -> float:
     """Whole games per second (median game time), recorder as the overrides say."""
     times = [game_seconds([*overrides, f"game.seed={seed}"], out_dir) for seed in range(games)]
     return 1.0 / statistics.median(times)
+
+
+#: the team sizes (N pursuers, M evaders) whose game cost the bench reports
+TEAM_SIZES = ((1, 1), (2, 1), (3, 1), (4, 1), (2, 2), (3, 2))
+
+
+def team_scaling(games: int, out_dir: str, t_max: float = 90.0) -> dict[str, float]:
+    """Seconds per game of S-S teams on the enclosed map, by 'NvM' (N smart pursuers
+    against M smart evaders, median over ``games`` seeds): how a game's cost grows with
+    the team (one visibility region per pursuer and a detector per pair every tick, one
+    estimator and one evader decision per evader)."""
+    base = ["recorder=none", "env=enclosed", f"game.t_max={t_max}"]
+    return {
+        f"{n}v{m}": statistics.median(
+            game_seconds(
+                [*base, f"team.pursuers={n}", f"team.evaders={m}", f"game.seed={seed}"], out_dir
+            )
+            for seed in range(games)
+        )
+        for n, m in TEAM_SIZES
+    }
 
 
 def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]:
@@ -277,6 +299,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             ss = ["pursuer=smart", "evader=smart", "recorder=none", f"env={name}"]
             row["ss_games_per_s"] = games_per_second(ss, games, tmp) if smart else None
         report["recorder_overhead"], report["rrd_mb_per_game"] = recorder_cost(3 * games, tmp)
+        report["team_game_s"] = team_scaling(games, tmp, 30.0 if args.quick else 90.0)
     for key in ("visibility_ms", "distance_field_ms", "plan_ms", "pf_step_ms"):
         values = [m[key] for m in per_map.values() if m.get(key) is not None]
         report[key] = max(values) if values else None  # the worst paper map
@@ -332,6 +355,11 @@ def format_report(report: dict[str, Any]) -> str:
         f"recorder: +{fmt(None if overhead is None else 100 * overhead)}% game time, "
         f"{fmt(report['rrd_mb_per_game'])} MB per 90 s game"
     )
+    teams = report.get("team_game_s") or {}
+    if teams:
+        one = teams.get("1v1") or 1.0
+        scaled = ", ".join(f"{k} {v:.2f} s (x{v / one:.1f})" for k, v in teams.items())
+        lines.append(f"team games on enclosed (S-S, s per game): {scaled}")
     lines.append(f"env steps/s (PettingZoo, random actions): {fmt(report['env_steps_per_s'])}")
     from pegame.envs.bench import format_vector
 

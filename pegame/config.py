@@ -3,7 +3,7 @@
 The composed config has one node per plugin group (``sim``, ``detector``, ``estimator``,
 ``pursuer``, ``evader``, ``recorder``), each with a ``name`` that the registry resolves;
 those nodes are validated by the plugin's own ``Config`` dataclass. The fixed nodes
-(``game``, ``camera``, ``env``) are validated here, as a structured-config schema that
+(``game``, ``camera``, ``env``, ``team``) are validated here, as a structured-config schema that
 Hydra applies at composition (unknown keys, wrong types) and range checks that
 :func:`game_settings` applies before a game starts.
 """
@@ -121,6 +121,54 @@ class GameConfig:
 
 
 @dataclass
+class TeamConfig:
+    """The teams: how many pursuers and evaders play, and which plugin each one is.
+
+    ``pursuers`` (and ``evaders``) is a count N >= 1 of copies of the ``pursuer`` node's
+    plugin, or a list with one member per pursuer: a plugin name (``random``) or a node
+    ``{name: smart, standoff: 1.0}`` whose keys override the ``pursuer`` node's for that
+    member (every member has the role's body: the bodies are set in the ``pursuer`` node).
+    Member 0 of a 1v1 game (the default, 1 and 1) is today's game.
+    """
+
+    pursuers: Any = 1  # N copies of pursuer's plugin, or a list of members (names or nodes)
+    evaders: Any = 1  # M copies of evader's plugin, or a list of members (names or nodes)
+
+
+#: the most members a team may have: a bound on the spawn's work, not on the model
+MAX_TEAM = 16
+
+
+def team_members(value: Any, role: str) -> list[dict[str, Any]]:
+    """The members of ``team.<role>s`` as override nodes (``{}`` for a copy of the role's
+    node): a count gives that many copies, a list one node per entry. ConfigError naming
+    the key and what is allowed for anything else."""
+    key = f"team.{role}s"
+    allowed = (
+        f"a whole number of {role}s from 1 to {MAX_TEAM}, or a list of members, each a "
+        f"{role} plugin name or a node with its name and the options that differ "
+        f"(e.g. [smart, {{name: smart, standoff: 1.0}}])"
+    )
+    if isinstance(value, Mapping):
+        raise ConfigError(f"Invalid value for '{key}': {dict(value)!r}. Allowed: {allowed}.")
+    if isinstance(value, Sequence) and not isinstance(value, str):
+        entries = list(value)
+        members: list[dict[str, Any]] = []
+        for entry in entries:
+            if isinstance(entry, str) and entry:
+                members.append({"name": entry})
+            elif isinstance(entry, Mapping) and isinstance(entry.get("name"), str):
+                members.append(dict(entry))
+            else:
+                raise ConfigError(f"Invalid member {entry!r} in '{key}'. Allowed: {allowed}.")
+        require(1 <= len(members) <= MAX_TEAM, key, allowed, entries)
+        return members
+    count_ok = isinstance(value, int) and not isinstance(value, bool)
+    require(count_ok and 1 <= value <= MAX_TEAM, key, allowed, value)
+    return [{} for _ in range(value)]
+
+
+@dataclass
 class EnvConfig:
     """The environment: a ROS map_server YAML (absolute, relative to the working
     directory, or the name of a map shipped with pegame, e.g. ``hall.yaml``)."""
@@ -149,6 +197,7 @@ Schema = make_dataclass(
         ("camera", Any, field(default_factory=_schema_of(Camera))),
         ("env", EnvConfig, field(default_factory=EnvConfig)),
         *[(kind, Any, field(default=MISSING)) for kind in PLUGIN_KINDS],
+        ("team", TeamConfig, field(default_factory=TeamConfig)),
         ("resume", bool, field(default=False)),
     ],
 )

@@ -57,11 +57,14 @@ def plot_trajectory(
     pairing: str | None = None,
     tracking_rate: float | None = None,
     title: str | None = None,
+    header: Sequence[str] | None = None,
 ) -> Path:
-    """Draw the map and both agents' trajectories and write them as a PNG to ``path``.
+    """Draw the map and every agent's trajectory and write them as a PNG to ``path``.
 
-    trajectory: rows with the columns of ``pegame.game.TRAJECTORY_HEADER`` (numbers or
-    their text, as in trajectory.csv). The axes are map-frame metres, the map drawn with
+    trajectory: rows with the columns of ``header`` (numbers or their text, as in
+    trajectory.csv): by default ``pegame.game.TRAJECTORY_HEADER`` (one pursuer, one
+    evader), or a team game's :func:`pegame.game.team_header` (``pursuer_<i>_x``, ...),
+    whose members are drawn in shades of their role's colour. The axes are map-frame metres, the map drawn with
     its resolution and origin (yaw included); the pursuer is red, the evader green, each
     start a dot. The title is ``title`` when given (wrapped to the figure's width), else
     the map's name with the pairing (e.g. 'S-R') and the tracking rate in [0, 1] when
@@ -71,8 +74,9 @@ def plot_trajectory(
     from matplotlib.figure import Figure
     from matplotlib.transforms import Affine2D
 
-    rows = np.asarray(trajectory, dtype=float).reshape(-1, len(TRAJECTORY_HEADER))
-    column = {name: rows[:, i] for i, name in enumerate(TRAJECTORY_HEADER)}
+    header = tuple(header or TRAJECTORY_HEADER)
+    rows = np.asarray(trajectory, dtype=float).reshape(-1, len(header))
+    column = {name: rows[:, i] for i, name in enumerate(header)}
     figure = Figure(figsize=(7.0, 7.0 * grid.height / max(grid.width, 1) + 0.6), dpi=120)
     FigureCanvasAgg(figure)
     axes = figure.add_subplot()
@@ -101,8 +105,8 @@ def plot_trajectory(
         )
         axes.set_xlim(corners[:, 0].min(), corners[:, 0].max())
         axes.set_ylim(corners[:, 1].min(), corners[:, 1].max())
-    for name, color in (("pursuer", PURSUER_COLOR), ("evader", EVADER_COLOR)):
-        x, y = column[f"{name}_x"], column[f"{name}_y"]
+    for name, key, color in agents(header):
+        x, y = column[f"{key}_x"], column[f"{key}_y"]
         axes.plot(x, y, color=color, linewidth=1.5, label=name)
         if len(x):
             axes.plot(x[:1], y[:1], "o", color=color, markersize=7, markeredgecolor="black")
@@ -119,6 +123,27 @@ def plot_trajectory(
     figure.savefig(buffer, format="png")
     write_atomic(path, buffer.getvalue())
     return Path(path)
+
+
+def agents(header: Sequence[str]) -> list[tuple[str, str, str]]:
+    """(label, column prefix, colour) of each agent of a trajectory ``header``: 'pursuer'
+    and 'evader' in 1v1, 'pursuer 0', 'pursuer 1', ... in a team game, member 0 in its
+    role's colour and the others lighter."""
+    from matplotlib.colors import to_hex, to_rgb
+
+    found = []
+    for role, base in (("pursuer", PURSUER_COLOR), ("evader", EVADER_COLOR)):
+        if f"{role}_x" in header:
+            found.append((role, role, base))
+            continue
+        members = 0
+        while f"{role}_{members}_x" in header:
+            members += 1
+        for k in range(members):
+            fade = 0.6 * k / max(members, 1)  # towards white, never all the way
+            color = to_hex([c + (1 - c) * fade for c in to_rgb(base)])
+            found.append((f"{role} {k}", f"{role}_{k}", color))
+    return found
 
 
 def _title(map_name: str, pairing: str | None, tracking_rate: float | None) -> str:

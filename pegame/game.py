@@ -10,6 +10,11 @@ A :class:`Scenario` is the config validated once: the map, the bodies, the camer
 plugin classes and their configs. ``scenario.game(seed)`` builds one :class:`Game`: every
 component gets its own generator from the master seed (one SeedSequence stream per
 component, in :data:`STREAMS` order), so the same scenario and seed give the same game.
+
+Teams (``team.pursuers``, ``team.evaders``): member 0 of each role, detector pair (0, 0)
+and evader 0's estimator get the 1v1 game's generators; every other member draws from a
+stream spawned after them (:meth:`Game._member_rng`), and the spawn places the 1v1
+game's pair first (:func:`spawn_team`), so a 1v1 game is the special case, unchanged.
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ import io
 import json
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -28,13 +33,13 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from pegame import registry
-from pegame.api import INTERFACES, Context
-from pegame.config import EnvConfig, GameConfig, resolve_map_path, typed
-from pegame.errors import SpawnError
+from pegame.api import INTERFACES, Context, Tick
+from pegame.config import EnvConfig, GameConfig, TeamConfig, resolve_map_path, team_members, typed
+from pegame.errors import ConfigError, SpawnError
 from pegame.files import write_atomic
 from pegame.grid import OccupancyGrid, load_map
-from pegame.loop import TickLoop
-from pegame.metrics import TrackingMetrics
+from pegame.loop import TickLoop, check_team
+from pegame.metrics import TeamMetrics, TrackingMetrics
 from pegame.navigation import Planner
 from pegame.types import Body, Camera, Pose
 from pegame.visibility import in_view, visibility_region
@@ -73,11 +78,15 @@ def pairing(pursuer: str, evader: str) -> str:
 
 def spawn(context: Context, rng: np.random.Generator, attempts: int = 500) -> tuple[Pose, Pose]:
     """Random start poses: the pursuer on a free cell it can move from, the evader on a
-    free cell in the pursuer's view (FOV, range, line of sight) that the pursuer can reach.
+    free cell in the pursuer's view (FOV, range, line of sight) that the pursuer can reach,
+    the two bodies apart (centres at least the sum of their radii from each other).
 
+    An evader cell that would overlap the pursuer is passed over for the next one drawn,
+    so only the seeds whose first choice overlapped start elsewhere.
     Raises SpawnError when ``attempts`` pursuer draws give no valid pair.
     """
     grid, camera = context.grid, context.camera
+    apart = context.pursuer.radius + context.evader.radius
     pursuer_space = Planner.shared(grid, context.pursuer.radius).traversable
     evader_space = Planner.shared(grid, context.evader.radius).traversable
     rows, cols = np.nonzero(pursuer_space)
@@ -89,7 +98,7 @@ def spawn(context: Context, rng: np.random.Generator, attempts: int = 500) -> tu
         order = rng.permutation(er.size)
         for j in order[:20]:
             ex, ey = grid.cell_to_world(er[j], ec[j])
-            if in_view(grid, camera, pursuer, (ex, ey)):
+            if math.hypot(ex - x, ey - y) >= apart and in_view(grid, camera, pursuer, (ex, ey)):
                 return pursuer, Pose(ex, ey, float(rng.uniform(-math.pi, math.pi)))
     raise SpawnError(
         f"No valid spawn on map '{grid.name}': after {attempts} tries there is no free pose for "
@@ -99,12 +108,74 @@ def spawn(context: Context, rng: np.random.Generator, attempts: int = 500) -> tu
     )
 
 
+def _apart(x: float, y: float, radius: float, placed: list[tuple[Pose, float]]) -> bool:
+    """Whether a body of ``radius`` (m) at (x, y) overlaps none of the ``placed`` (pose,
+    radius) bodies."""
+    return all(math.hypot(x - p.x, y - p.y) >= radius + r for p, r in placed)
+
+
+def spawn_team(
+    context: Context, rng: np.random.Generator, pursuers: int, evaders: int, attempts: int = 200
+) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
+    """Start poses of N ``pursuers`` and M ``evaders``: pursuer 0 and evader 0 as
+    :func:`spawn` draws them (a 1v1 game's start, so games of every team size on one
+    seed share it), then the other pursuers on free cells they can move from, then the
+    other evaders on free cells in the view of at least one pursuer; no two bodies
+    overlap (centres at least the sum of their radii apart). The extra members draw from
+    ``rng`` after the first pair; when they find no room the whole team is drawn again.
+
+    Raises SpawnError naming the map and the team when ``attempts`` draws give none.
+    """
+    first = spawn(context, rng)
+    if pursuers == 1 and evaders == 1:
+        return (first[0],), (first[1],)
+    grid, camera = context.grid, context.camera
+    rp, re = context.pursuer.radius, context.evader.radius
+    pursuer_cells = np.column_stack(np.nonzero(Planner.shared(grid, rp).traversable))
+    evader_space = Planner.shared(grid, re).traversable
+    for _ in range(attempts):
+        placed = [(first[0], rp), (first[1], re)]
+        team_p, team_e = [first[0]], [first[1]]
+        for _member in range(pursuers - 1):
+            for k in rng.integers(len(pursuer_cells), size=50):
+                x, y = grid.cell_to_world(*pursuer_cells[k])
+                if _apart(x, y, rp, placed):
+                    pose = Pose(x, y, float(rng.uniform(-math.pi, math.pi)))
+                    team_p.append(pose)
+                    placed.append((pose, rp))
+                    break
+        seen = np.zeros(grid.blocked.shape, dtype=bool)
+        for pose in team_p:
+            seen |= visibility_region(grid, pose, camera)
+        er, ec = np.nonzero(seen & evader_space)
+        for _member in range(evaders - 1):
+            for j in rng.permutation(er.size)[:50]:
+                x, y = grid.cell_to_world(er[j], ec[j])
+                watched = any(in_view(grid, camera, p, (x, y)) for p in team_p)
+                if watched and _apart(x, y, re, placed):
+                    pose = Pose(x, y, float(rng.uniform(-math.pi, math.pi)))
+                    team_e.append(pose)
+                    placed.append((pose, re))
+                    break
+        if len(team_p) == pursuers and len(team_e) == evaders:
+            return tuple(team_p), tuple(team_e)
+        first = spawn(context, rng)
+    raise SpawnError(
+        f"No valid spawn on map '{grid.name}' for a team of {pursuers} pursuer(s) (radius "
+        f"{rp} m) and {evaders} evader(s) (radius {re} m): after {attempts} tries there is no "
+        "room for every body apart with each evader in some pursuer's view. Use a map with "
+        "more free space, a smaller team (team.pursuers, team.evaders) or smaller radii."
+    )
+
+
 @dataclass
 class Outcome:
-    """A played game: its result (JSON-ready, no wall-clock values) and trajectory rows."""
+    """A played game: its result (JSON-ready, no wall-clock values), trajectory rows and
+    their column names."""
 
     result: dict[str, Any]
     trajectory: list[tuple]
+    header: tuple[str, ...] = ()
 
 
 TRAJECTORY_HEADER = (
@@ -119,6 +190,67 @@ TRAJECTORY_HEADER = (
     "detected",
     "in_view",
 )
+
+
+def trajectory_row(t: Tick) -> tuple:
+    """A 1v1 tick as a row of :data:`TRAJECTORY_HEADER`."""
+    p, e = t.pursuer, t.evader
+    return (
+        t.step,
+        round(t.time, 6),
+        p.x,
+        p.y,
+        p.theta,
+        e.x,
+        e.y,
+        e.theta,
+        int(t.detection is not None),
+        int(t.in_view),
+    )
+
+
+def team_header(pursuers: int, evaders: int) -> tuple[str, ...]:
+    """The trajectory columns of a team game: step, time, every pursuer's pose
+    (``pursuer_<i>_x`` ...), every evader's, then per evader whether some pursuer
+    detected it (``detected_<j>``) and had it in view (``in_view_<j>``)."""
+    poses = [
+        f"{role}_{k}_{axis}"
+        for role, count in (("pursuer", pursuers), ("evader", evaders))
+        for k in range(count)
+        for axis in ("x", "y", "theta")
+    ]
+    flags = [f"{flag}_{j}" for j in range(evaders) for flag in ("detected", "in_view")]
+    return ("step", "time", *poses, *flags)
+
+
+def team_trajectory_row(t: Tick) -> tuple:
+    """A team tick as a row of :func:`team_header`."""
+    team = t.team
+    poses = [v for pose in (*team.pursuers, *team.evaders) for v in (pose.x, pose.y, pose.theta)]
+    flags = []
+    for j in range(len(team.evaders)):
+        flags.append(int(any(row[j] is not None for row in team.detections)))
+        flags.append(int(any(row[j] for row in team.in_view)))
+    return (t.step, round(t.time, 6), *poses, *flags)
+
+
+def check_room_for_team(context: Context, pursuers: int, evaders: int) -> None:
+    """SpawnError naming the map and the team when the map cannot hold the team's bodies
+    apart: fewer traversable cells on a lattice of spacing twice the largest radius (the
+    centres of bodies that cannot overlap) than there are members."""
+    grid = context.grid
+    radius = max(context.pursuer.radius, context.evader.radius)
+    step = max(1, math.ceil(2 * radius / grid.resolution))
+    room = 0
+    for body in (context.pursuer, context.evader):
+        space = Planner.shared(grid, body.radius).traversable
+        room = max(room, int(np.count_nonzero(space[::step, ::step])))
+    if room < pursuers + evaders:
+        raise SpawnError(
+            f"No valid spawn on map '{grid.name}' for a team of {pursuers} pursuer(s) and "
+            f"{evaders} evader(s): it has room for {room} bodies of radius {radius} m apart. "
+            "Use a smaller team (team.pursuers, team.evaders), a larger map or smaller radii."
+        )
 
 
 class Scenario:
@@ -166,6 +298,58 @@ class Scenario:
             if check_context is not None:
                 check_context(self.context)
         self.config = OmegaConf.to_container(cfg, resolve=True)
+        self.team = self._team(cfg)
+        self.team_size = (len(self.team["pursuer"]), len(self.team["evader"]))
+        if self.team_size != (1, 1):
+            check_team(self.classes["sim"], self.classes["detector"], *self.team_size)
+            check_room_for_team(self.context, *self.team_size)
+
+    def _team(self, cfg: DictConfig) -> dict[str, list[tuple[str, type, Any]]]:
+        """The members of each role as (plugin name, class, config): ``team.pursuers`` and
+        ``team.evaders`` (:class:`pegame.config.TeamConfig`); member 0 of a count is the
+        role's own plugin. A member naming another plugin keeps only the role's body keys
+        (its plugin's own options come from its Config defaults and its node)."""
+        team: TeamConfig = typed(cfg.get("team", {}), TeamConfig, "team")
+        members: dict[str, list[tuple[str, type, Any]]] = {}
+        for role in ("pursuer", "evader"):
+            body_keys = {f.name for f in fields(INTERFACES[role].Config)}
+            base = {k: v for k, v in OmegaConf.to_container(cfg[role]).items() if k != "name"}
+            entries = team_members(getattr(team, f"{role}s"), role)
+            members[role] = []
+            for index, entry in enumerate(entries):
+                name = str(entry.get("name", self.names[role]))
+                options = {k: v for k, v in entry.items() if k != "name"}
+                clash = sorted(set(options) & body_keys)
+                if clash:
+                    raise ConfigError(
+                        f"Invalid key 'team.{role}s[{index}].{clash[0]}': every {role} of a team "
+                        f"has the role's body. Allowed: set it for all in '{role}.{clash[0]}'; "
+                        f"a member sets only its plugin's own options."
+                    )
+                if not entry or (name == self.names[role] and not options):
+                    members[role].append((name, self.classes[role], self.configs[role]))
+                    continue
+                kept = (
+                    base
+                    if name == self.names[role]
+                    else {k: v for k, v in base.items() if k in body_keys}
+                )
+                cls = registry.load(role, name)
+                config = registry.make_config(role, cls, {**kept, **options})
+                members[role].append((name, cls, config))
+        return members
+
+    def member(self, kind: str, index: int) -> tuple[type, Any]:
+        """The (class, config) of member ``index`` of a role, or of ``kind``'s plugin."""
+        if kind in self.team:
+            _, cls, config = self.team[kind][index]
+            return cls, config
+        return self.classes[kind], self.configs[kind]
+
+    def member_names(self, role: str) -> str:
+        """The plugin name of a role's members, '+'-joined in member order when they differ."""
+        names = list(dict.fromkeys(name for name, _, _ in self.team[role]))
+        return "+".join(names)
 
     def game(self, seed: int) -> Game:
         """The game of this scenario with master seed ``seed``."""
@@ -192,11 +376,51 @@ class Game:
         streams = dict(zip(STREAMS, np.random.SeedSequence(self.seed).spawn(len(STREAMS))))
         self.spawn_rng = np.random.default_rng(streams["spawn"])
         self.plugins = {
-            kind: scenario.classes[kind](
-                scenario.configs[kind], self.context, np.random.default_rng(streams[kind])
+            kind: scenario.member(kind, 0)[0](
+                scenario.member(kind, 0)[1], self.context, np.random.default_rng(streams[kind])
             )
             for kind in INTERFACES
         }
+        self.team = self._members() if scenario.team_size != (1, 1) else None
+
+    def _member_rng(self, kind: str, *index: int) -> np.random.Generator:
+        """The generator of member ``index`` of ``kind`` (a team's extra members): a stream
+        after every 1v1 stream (spawn key ``len(STREAMS)``), so member 0 keeps the 1v1
+        game's generator."""
+        key = (len(STREAMS), STREAMS.index(kind), *index)
+        return np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=key))
+
+    def _members(self) -> dict[str, list]:
+        """The team's plugins by kind, for :class:`pegame.loop.TickLoop`: member 0 of each
+        is the 1v1 plugin, the others are built with their own generators."""
+        scenario, context = self.scenario, self.context
+        n, m = scenario.team_size
+        team: dict[str, list] = {}
+        for role in ("pursuer", "evader"):
+            team[role] = [self.plugins[role]] + [
+                cls(config, context, self._member_rng(role, k))
+                for k, (_, cls, config) in enumerate(scenario.team[role])
+                if k > 0
+            ]
+        detector, estimator = scenario.classes["detector"], scenario.classes["estimator"]
+        team["detector"] = [
+            [
+                self.plugins["detector"]
+                if (i, j) == (0, 0)
+                else detector(
+                    scenario.configs["detector"], context, self._member_rng("detector", i, j)
+                )
+                for j in range(m)
+            ]
+            for i in range(n)
+        ]
+        team["estimator"] = [
+            self.plugins["estimator"]
+            if j == 0
+            else estimator(scenario.configs["estimator"], context, self._member_rng("estimator", j))
+            for j in range(m)
+        ]
+        return team
 
     def start(self, external: tuple[str, ...] = (), estimate: bool = True) -> TickLoop:
         """Spawn both agents and return the game's tick loop at tick 0 (see TickLoop)."""
@@ -210,8 +434,9 @@ class Game:
             estimate,
             substeps=settings.substeps,
             turn_order=settings.turn_order,
+            team=self.team,
         )
-        loop.start(*spawn(self.context, self.spawn_rng))
+        loop.start(*spawn_team(self.context, self.spawn_rng, *self.scenario.team_size))
         return loop
 
     def play(self, out_dir: str | Path, recording_name: str = "game") -> Outcome:
@@ -225,24 +450,10 @@ class Game:
             loop = self.start()
             recorder.start(str(out_dir), recording_name, config)
             trajectory: list[tuple] = []
+            row = trajectory_row if self.team is None else team_trajectory_row
             try:
                 while not loop.done:
-                    t = loop.advance()
-                    p, e = t.pursuer, t.evader
-                    trajectory.append(
-                        (
-                            t.step,
-                            round(t.time, 6),
-                            p.x,
-                            p.y,
-                            p.theta,
-                            e.x,
-                            e.y,
-                            e.theta,
-                            int(t.detection is not None),
-                            int(t.in_view),
-                        )
-                    )
+                    trajectory.append(row(loop.advance()))
                 result = self._result(loop.metrics)
             except BaseException as error:
                 recorder.abort(error)
@@ -250,10 +461,13 @@ class Game:
             recorder.finish(result)
         finally:
             self.plugins["sim"].close()
-        return Outcome(result, trajectory)
+        header = TRAJECTORY_HEADER if self.team is None else team_header(*self.scenario.team_size)
+        return Outcome(result, trajectory, header)
 
-    def _result(self, metrics: TrackingMetrics) -> dict[str, Any]:
-        s, names = self.scenario.settings, self.scenario.names
+    def _result(self, metrics: TrackingMetrics | TeamMetrics) -> dict[str, Any]:
+        s, names = self.scenario.settings, dict(self.scenario.names)
+        names["pursuer"] = self.scenario.member_names("pursuer")
+        names["evader"] = self.scenario.member_names("evader")
         return {
             "pairing": pairing(names["pursuer"], names["evader"]),
             "pursuer": names["pursuer"],
@@ -277,7 +491,7 @@ def write_outcome(outcome: Outcome, out_dir: str | Path) -> None:
     out_dir = Path(out_dir)
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(TRAJECTORY_HEADER)
+    writer.writerow(outcome.header or TRAJECTORY_HEADER)
     writer.writerows(outcome.trajectory)
     write_atomic(out_dir / "trajectory.csv", buffer.getvalue())
     write_atomic(out_dir / "result.json", json.dumps(outcome.result, indent=2) + "\n")

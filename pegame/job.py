@@ -267,6 +267,7 @@ def write_single(outcome: Outcome, game: Game, out_dir: Path) -> None:
             outcome.trajectory,
             out_dir / "trajectory.png",
             title=summary_line(outcome.result),
+            header=outcome.header or None,
         )
         write_outcome(outcome, out_dir)
     except OSError as exc:

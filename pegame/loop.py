@@ -28,6 +28,18 @@ Timing (``game.physics_hz``, ``game.turn_order``; every default keeps the order 
   ``control_dt`` with the evader paused. No role may be ``external`` then (an external
   pursuer would have to command before it could see the evader's move).
 
+Teams (``team.pursuers`` = N, ``team.evaders`` = M; a 1v1 game is N = M = 1 and plays as
+it always has): the simulator holds every agent and gives each pursuer's camera frame;
+one detector per (pursuer i, evader j) pair looks for evader j in pursuer i's frame; one
+estimator per evader is fed by every pursuer's detection of it and by the union of the
+pursuers' regions (:class:`pegame.visibility.UnionRegion`, the team's negative
+information); all evaders decide, then all pursuers, in member order; each pursuer's
+observation carries its own pose, region and detection of its target evader (i mod M)
+with the team's belief about it, plus the whole team's view
+(:class:`pegame.api.PursuerTeam`); each evader's carries the nearest pursuer and the union
+region. Member 0 of each role, and detector (0, 0), use the generators a 1v1 game gives
+its plugins (:mod:`pegame.game`).
+
 Roles listed as ``external`` take their commands from the caller (a learner in the
 environments) instead of their strategy. When no strategy pursuer needs the belief, the
 estimator and the region can be skipped (``estimate=False``: they are the most expensive
@@ -40,22 +52,33 @@ part of a tick); the belief is then empty and the game has no estimation error.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 from pegame.api import (
     Context,
     EvaderObservation,
     Plugin,
     PursuerObservation,
+    PursuerTeam,
     Simulator,
+    TeamTick,
     Tick,
 )
 from pegame.config import TURN_ORDERS
 from pegame.errors import ConfigError
-from pegame.metrics import TrackingMetrics
+from pegame.metrics import TeamMetrics, TrackingMetrics
 from pegame.types import EMPTY_BELIEF, Belief, Detection, Plan, Pose, SensorFrame, Velocity
-from pegame.visibility import VisibilityRegion, body_in_view
+from pegame.visibility import UnionRegion, VisibilityRegion, body_in_view
 
 ROLES = ("pursuer", "evader")
+
+
+def nearest(poses: Sequence[Pose], to: Pose) -> int:
+    """The index of the pose in ``poses`` nearest to ``to`` (the lowest among ties)."""
+    if len(poses) == 1:
+        return 0
+    distances = [(p.x - to.x) ** 2 + (p.y - to.y) ** 2 for p in poses]
+    return distances.index(min(distances))
 
 
 class TickLoop:
@@ -66,6 +89,9 @@ class TickLoop:
     the roles commanded by the caller; estimate: run the estimator and build the region
     (forced on when the pursuer is a strategy, which needs them); substeps: simulator
     steps per control tick; turn_order: one of :data:`pegame.config.TURN_ORDERS`.
+    team: the members of a team game by kind: ``pursuer`` (N strategies), ``evader`` (M),
+    ``detector`` (N lists of M: pair (i, j)) and ``estimator`` (M); None for a 1v1 game
+    (``plugins``' own). An external role is commanded with one velocity per member.
     """
 
     def __init__(
@@ -78,6 +104,7 @@ class TickLoop:
         estimate: bool = True,
         substeps: int = 1,
         turn_order: str = "simultaneous",
+        team: Mapping[str, Sequence] | None = None,
     ) -> None:
         unknown = sorted(set(external) - set(ROLES))
         if unknown:
@@ -98,13 +125,20 @@ class TickLoop:
             )
         if substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps}.")
-        self.sim, self.detector, self.estimator = (
-            plugins["sim"],
-            plugins["detector"],
-            plugins["estimator"],
-        )
-        self.pursuer_strategy, self.evader_strategy = plugins["pursuer"], plugins["evader"]
-        self.recorder = plugins["recorder"]
+        self.sim, self.recorder = plugins["sim"], plugins["recorder"]
+        team = team or {
+            "pursuer": [plugins["pursuer"]],
+            "evader": [plugins["evader"]],
+            "detector": [[plugins["detector"]]],
+            "estimator": [plugins["estimator"]],
+        }
+        self.pursuer_strategies = list(team["pursuer"])
+        self.evader_strategies = list(team["evader"])
+        self.detectors = [list(row) for row in team["detector"]]
+        self.estimators = list(team["estimator"])
+        self.n_pursuers, self.n_evaders = len(self.pursuer_strategies), len(self.evader_strategies)
+        self.solo = self.n_pursuers == 1 and self.n_evaders == 1
+        check_team(type(self.sim), type(self.detectors[0][0]), self.n_pursuers, self.n_evaders)
         self.context = context
         self.ticks = ticks
         self.decide_every = decide_every
@@ -112,9 +146,14 @@ class TickLoop:
         self.estimate = estimate or "pursuer" not in self.external
         self.substeps = substeps
         self.turn_order = turn_order
-        self.metrics = TrackingMetrics(context.control_dt)
+        self.metrics: TrackingMetrics | TeamMetrics = (
+            TrackingMetrics(context.control_dt)
+            if self.solo
+            else TeamMetrics(context, self.n_pursuers, self.n_evaders)
+        )
         self.step = 0
-        self.plans = (Plan(), Plan())
+        self.pursuer_plans = [Plan()] * self.n_pursuers
+        self.evader_plans = [Plan()] * self.n_evaders
 
     @property
     def time(self) -> float:
@@ -130,119 +169,307 @@ class TickLoop:
     def evader_first(self) -> bool:
         return self.turn_order == "evader_first"
 
-    def start(self, pursuer: Pose, evader: Pose) -> None:
-        """Place both agents, reset every plugin and sense tick 0 (with ``evader_first``,
-        tick 0 is sensed after the evader's first move, in :meth:`advance`)."""
-        self.sim.reset(pursuer, evader)
-        self.detector.reset()
-        self.pursuer_strategy.reset(pursuer)
-        self.evader_strategy.reset(evader)
+    # -- member 0's view, the 1v1 game's names
+
+    @property
+    def pursuer(self) -> Pose:
+        """Pursuer 0's true pose at the current tick."""
+        return self.pursuers[0]
+
+    @property
+    def evader(self) -> Pose:
+        """Evader 0's true pose at the current tick."""
+        return self.evaders[0]
+
+    @property
+    def detection(self) -> Detection | None:
+        """Pursuer 0's detection of evader 0 at the current tick."""
+        return self.detections[0][0]
+
+    @property
+    def belief(self) -> Belief:
+        """The belief about evader 0 at the current tick."""
+        return self.beliefs[0]
+
+    @property
+    def region(self) -> VisibilityRegion | None:
+        """Pursuer 0's visibility region at the current tick (None when not computed)."""
+        return self.regions[0]
+
+    @property
+    def frame(self) -> SensorFrame:
+        """Pursuer 0's sensor frame at the current tick."""
+        return self.frames[0]
+
+    @property
+    def in_view(self) -> bool:
+        """Ground truth: evader 0's body in the view of some pursuer at the current tick."""
+        return self.in_views[0][0] if self.solo else any(row[0] for row in self.in_views)
+
+    @property
+    def plans(self) -> tuple[Plan, Plan]:
+        """The latest (pursuer 0, evader 0) plans."""
+        return self.pursuer_plans[0], self.evader_plans[0]
+
+    def start(self, pursuer: Pose | Sequence[Pose], evader: Pose | Sequence[Pose]) -> None:
+        """Place the agents (a pose per role in 1v1, a sequence of poses per role for a
+        team), reset every plugin and sense tick 0 (with ``evader_first``, tick 0 is sensed
+        after the evaders' first move, in :meth:`advance`)."""
+        pursuers = (pursuer,) if isinstance(pursuer, Pose) else tuple(pursuer)
+        evaders = (evader,) if isinstance(evader, Pose) else tuple(evader)
+        if (len(pursuers), len(evaders)) != (self.n_pursuers, self.n_evaders):
+            raise ValueError(
+                f"start needs {self.n_pursuers} pursuer and {self.n_evaders} evader poses, "
+                f"got {len(pursuers)} and {len(evaders)}."
+            )
+        self.sim.reset_team(pursuers, evaders)
+        for row in self.detectors:
+            for detector in row:
+                detector.reset()
+        for strategy, pose in zip(self.pursuer_strategies, pursuers):
+            strategy.reset(pose)
+        for strategy, pose in zip(self.evader_strategies, evaders):
+            strategy.reset(pose)
         if self.evader_first:
-            self.pursuer, self.evader = pursuer, evader
+            self.pursuers, self.evaders = pursuers, evaders
+            self.regions: tuple[VisibilityRegion | None, ...] = (None,) * self.n_pursuers
         else:
             self._sense()
 
-    def _sense(self, region: VisibilityRegion | None = None) -> None:
-        """The current tick's poses, frame, detection, region, belief and in_view;
-        ``region``: the pursuer's region already built for its current pose, if any."""
-        grid, camera = self.context.grid, self.context.camera
-        self.pursuer, self.evader = self.sim.poses
-        self.frame: SensorFrame = self.sim.sense(self.time)
-        self.detection: Detection | None = self.detector.detect(self.frame)
-        self.region: VisibilityRegion | None = None
-        self.belief: Belief = EMPTY_BELIEF
+    def _sense(self, regions: tuple[VisibilityRegion, ...] | None = None) -> None:
+        """The current tick's poses, frames, detections, regions, beliefs and in_view;
+        ``regions``: the pursuers' regions already built for their current poses, if any."""
+        if self.solo:
+            self._sense_one(regions)
+            return
+        grid, camera, radius = self.context.grid, self.context.camera, self.context.evader.radius
+        self.pursuers, self.evaders = self.sim.team_poses
+        self.frames: tuple[SensorFrame, ...] = self.sim.sense_team(self.time)
+        self.detections = tuple(
+            tuple(_identified(detector.detect(frame.about(j)), j) for j, detector in enumerate(row))
+            for frame, row in zip(self.frames, self.detectors)
+        )
+        self.regions = (None,) * self.n_pursuers
+        self.union = None
+        self.beliefs: tuple[Belief, ...] = (EMPTY_BELIEF,) * self.n_evaders
         if self.estimate:
-            self.region = region or VisibilityRegion(grid, self.pursuer, camera)
-            if self.step == 0:
-                self.belief = self.estimator.reset(self.pursuer, self.detection, self.region)
-            else:
-                self.belief = self.estimator.update(
-                    self.context.control_dt, self.pursuer, self.detection, self.region
-                )
-        self.in_view = body_in_view(
-            grid, camera, self.pursuer, (self.evader.x, self.evader.y), self.context.evader.radius
+            self.regions = regions or tuple(
+                VisibilityRegion(grid, pose, camera) for pose in self.pursuers
+            )
+            self.union = self.regions[0] if self.n_pursuers == 1 else UnionRegion(self.regions)
+            self.beliefs = tuple(self._estimate(j) for j in range(self.n_evaders))
+        self.in_views = tuple(
+            tuple(body_in_view(grid, camera, p, (e.x, e.y), radius) for e in self.evaders)
+            for p in self.pursuers
         )
 
-    def pursuer_observation(self) -> PursuerObservation:
-        """What a pursuer strategy is given at this tick (needs ``estimate``)."""
-        return PursuerObservation(self.time, self.pursuer, self.detection, self.belief, self.region)
+    def _sense_one(self, regions: tuple[VisibilityRegion, ...] | None) -> None:
+        """:meth:`_sense` of a 1v1 game through the simulator's and estimator's 1v1
+        methods: the same tick, without the team's per-member loops (a 1v1 game's ticks
+        are the most played; this keeps them as fast as before teams)."""
+        grid, camera = self.context.grid, self.context.camera
+        pursuer, evader = self.sim.poses
+        frame = self.sim.sense(self.time)
+        detection = self.detectors[0][0].detect(frame)
+        region, belief = None, EMPTY_BELIEF
+        if self.estimate:
+            region = regions[0] if regions else VisibilityRegion(grid, pursuer, camera)
+            estimator = self.estimators[0]
+            if self.step == 0:
+                belief = estimator.reset(pursuer, detection, region)
+            else:
+                belief = estimator.update(self.context.control_dt, pursuer, detection, region)
+        seen = body_in_view(grid, camera, pursuer, (evader.x, evader.y), self.context.evader.radius)
+        self.pursuers, self.evaders, self.frames = (pursuer,), (evader,), (frame,)
+        self.detections, self.regions, self.union = ((detection,),), (region,), region
+        self.beliefs, self.in_views = (belief,), ((seen,),)
 
-    def evader_observation(self) -> EvaderObservation:
-        """What an evader strategy is given at this tick."""
-        return EvaderObservation(self.time, self.evader, self.pursuer, self.region)
+    def _estimate(self, j: int) -> Belief:
+        """Evader j's estimator, reset at tick 0 and updated after, by every pursuer."""
+        estimator = self.estimators[j]
+        if self.n_pursuers == 1:  # the 1v1 interface: one pursuer, its region
+            pursuer, detection, region = self.pursuers[0], self.detections[0][j], self.regions[0]
+            if self.step == 0:
+                return estimator.reset(pursuer, detection, region)
+            return estimator.update(self.context.control_dt, pursuer, detection, region)
+        detections = [row[j] for row in self.detections]
+        if self.step == 0:
+            return estimator.reset_team(self.pursuers, detections, self.union)
+        return estimator.update_team(self.context.control_dt, self.pursuers, detections, self.union)
 
-    def advance(self, commands: Mapping[str, Velocity] | None = None) -> Tick:
-        """Play the current tick with the external roles' ``commands`` (role -> velocity),
-        step the simulator and sense the next tick. Returns the tick that was played."""
+    def pursuer_observation(self, i: int = 0) -> PursuerObservation:
+        """What pursuer ``i`` is given at this tick (needs ``estimate``)."""
+        j = i % self.n_evaders
+        team = None
+        if not self.solo:
+            team = PursuerTeam(
+                i, j, self.pursuers, self.detections, self.beliefs, self.regions, self.union
+            )
+        return PursuerObservation(
+            self.time,
+            self.pursuers[i],
+            self.detections[i][j],
+            self.beliefs[j],
+            self.regions[i],
+            team,
+        )
+
+    def evader_observation(self, j: int = 0) -> EvaderObservation:
+        """What evader ``j`` is given at this tick: the pursuer nearest to it and the
+        union of the pursuers' regions."""
+        me = self.evaders[j]
+        near = 0 if self.n_pursuers == 1 else nearest(self.pursuers, me)
+        return EvaderObservation(self.time, me, self.pursuers[near], self.union, self.pursuers, j)
+
+    def advance(self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None = None) -> Tick:
+        """Play the current tick with the external roles' ``commands`` (role -> velocity,
+        or one velocity per member in a team game), step the simulator and sense the next
+        tick. Returns the tick that was played."""
         if self.done:
             raise RuntimeError("The game is over: every tick has been played.")
-        commanded = dict(commands or {})
+        commanded: dict[str, list[Velocity]] = {}
+        if commands:
+            for role, command in commands.items():
+                commanded[role] = [command] if isinstance(command, Velocity) else list(command)
         missing = [role for role in self.external if role not in commanded]
         if missing:
             raise ValueError(f"No command for the external role(s) {missing}.")
         deciding = self.step % self.decide_every == 0
-        e_plan, p_plan = self.plans[1], self.plans[0]
+        evaders, pursuers = self.evader_strategies, self.pursuer_strategies
         if self.evader_first:
-            # The evader's turn, on the world after the pursuer's last move: its own pose,
-            # the pursuer's, and the pursuer's region (kept for the sensing that follows,
-            # since the pursuer does not move in the evader's turn).
-            self.pursuer, self.evader = self.sim.poses
-            self.region = VisibilityRegion(self.context.grid, self.pursuer, self.context.camera)
-            e_obs = self.evader_observation()
+            # The evaders' turn, on the world after the pursuers' last move: their own
+            # poses, the pursuers', and the pursuers' regions (kept for the sensing that
+            # follows, since the pursuers do not move in the evaders' turn).
+            self.pursuers, self.evaders = self.sim.team_poses
+            grid, camera = self.context.grid, self.context.camera
+            self.regions = tuple(VisibilityRegion(grid, pose, camera) for pose in self.pursuers)
+            self.union = self.regions[0] if self.n_pursuers == 1 else UnionRegion(self.regions)
+            e_obs = [self.evader_observation(j) for j in range(self.n_evaders)]
             if deciding:
-                e_plan = self.evader_strategy.decide(e_obs)
-            commanded["evader"] = self.evader_strategy.control(e_obs)
-            self._integrate(evader=commanded["evader"])
-            self._sense(self.region)
+                self.evader_plans = [s.decide(o) for s, o in zip(evaders, e_obs)]
+            commanded["evader"] = [s.control(o) for s, o in zip(evaders, e_obs)]
+            self._integrate(evaders=commanded["evader"])
+            self._sense(self.regions)
             e_obs = None
+        elif "evader" not in self.external:
+            e_obs = [self.evader_observation(j) for j in range(self.n_evaders)]
         else:
-            e_obs = self.evader_observation() if "evader" not in self.external else None
-        p_obs = self.pursuer_observation() if "pursuer" not in self.external else None
-        if deciding:  # the evader first, then the pursuer (paper)
-            if e_obs is not None:
-                e_plan = self.evader_strategy.decide(e_obs)
-            if p_obs is not None:
-                p_plan = self.pursuer_strategy.decide(p_obs)
-            self.plans = (p_plan, e_plan)
-        if p_obs is not None:
-            commanded["pursuer"] = self.pursuer_strategy.control(p_obs)
-        if e_obs is not None:
-            commanded["evader"] = self.evader_strategy.control(e_obs)
-        velocities = (commanded["pursuer"], commanded["evader"])
-        self.metrics.add(
-            self.pursuer, self.evader, self.detection is not None, self.in_view, self.belief
+            e_obs = None
+        p_obs = (
+            [self.pursuer_observation(i) for i in range(self.n_pursuers)]
+            if "pursuer" not in self.external
+            else None
         )
+        if deciding:  # the evaders first, then the pursuers (paper)
+            if e_obs is not None:
+                self.evader_plans = [s.decide(o) for s, o in zip(evaders, e_obs)]
+            if p_obs is not None:
+                self.pursuer_plans = [s.decide(o) for s, o in zip(pursuers, p_obs)]
+        if p_obs is not None:
+            commanded["pursuer"] = [s.control(o) for s, o in zip(pursuers, p_obs)]
+        if e_obs is not None:
+            commanded["evader"] = [s.control(o) for s, o in zip(evaders, e_obs)]
+        p_cmds, e_cmds = commanded["pursuer"], commanded["evader"]
+        in_view = self.in_views[0][0] if self.solo else self.in_view
+        if self.solo:
+            self.metrics.add(
+                self.pursuers[0],
+                self.evaders[0],
+                self.detections[0][0] is not None,
+                in_view,
+                self.beliefs[0],
+            )
+        else:
+            self.metrics.add(
+                self.pursuers,
+                self.evaders,
+                self.detections,
+                self.in_views,
+                self.beliefs,
+                self.union if deciding else None,
+            )
         tick = Tick(
             self.step,
             self.time,
-            self.pursuer,
-            self.evader,
-            self.frame,
-            self.detection,
-            self.belief,
-            self.region,
-            self.in_view,
-            velocities,
-            self.plans,
+            self.pursuers[0],
+            self.evaders[0],
+            self.frames[0],
+            self.detections[0][0],
+            self.beliefs[0],
+            self.regions[0],
+            in_view,
+            (p_cmds[0], e_cmds[0]),
+            (self.pursuer_plans[0], self.evader_plans[0]),
+            None
+            if self.solo
+            else TeamTick(
+                self.pursuers,
+                self.evaders,
+                self.frames,
+                self.detections,
+                self.beliefs,
+                self.regions,
+                self.in_views,
+                tuple(p_cmds),
+                tuple(e_cmds),
+                tuple(self.pursuer_plans),
+                tuple(self.evader_plans),
+            ),
         )
         self.recorder.log(tick)
         if self.evader_first:
-            self._integrate(pursuer=velocities[0])
+            self._integrate(pursuers=p_cmds)
             self.step += 1
         else:
-            self._integrate(*velocities)
+            self._integrate(p_cmds, e_cmds)
             self.step += 1
             self._sense()  # also after the last tick: the environments observe the final state
         return tick
 
-    def _integrate(self, pursuer: Velocity | None = None, evader: Velocity | None = None) -> None:
+    def _integrate(
+        self, pursuers: Sequence[Velocity] | None = None, evaders: Sequence[Velocity] | None = None
+    ) -> None:
         """Hold the commands for one control period, in ``substeps`` simulator steps; a
-        role without a command is paused (``evader_first``'s turns)."""
+        role without commands is paused (``evader_first``'s turns)."""
         dt = self.context.control_dt / self.substeps
+        sim = self.sim
         for _ in range(self.substeps):
-            if pursuer is not None and evader is not None:
-                self.sim.step(pursuer, evader, dt)
-            elif pursuer is not None:
-                self.sim.step_one("pursuer", pursuer, dt)
-            elif evader is not None:
-                self.sim.step_one("evader", evader, dt)
+            if self.solo:  # the simulator's 1v1 methods, as before teams
+                if pursuers is not None and evaders is not None:
+                    sim.step(pursuers[0], evaders[0], dt)
+                elif pursuers is not None:
+                    sim.step_one("pursuer", pursuers[0], dt)
+                elif evaders is not None:
+                    sim.step_one("evader", evaders[0], dt)
+            elif pursuers is not None and evaders is not None:
+                sim.step_team(pursuers, evaders, dt)
+            elif pursuers is not None:
+                sim.step_team_one("pursuer", pursuers, dt)
+            elif evaders is not None:
+                sim.step_team_one("evader", evaders, dt)
+
+
+def _identified(detection: Detection | None, evader: int) -> Detection | None:
+    """``detection`` naming evader ``evader`` (a team detector pair knows whom it saw)."""
+    if detection is None or detection.evader == evader:
+        return detection
+    return replace(detection, evader=evader)
+
+
+def check_team(sim: type, detector: type, pursuers: int, evaders: int) -> None:
+    """ConfigError unless the simulator and detector classes can play N ``pursuers``
+    against M ``evaders``: a simulator that holds teams, and, against several evaders, a
+    detector that tells them apart."""
+    team = f"{pursuers} pursuer(s) against {evaders} evader(s)"
+    if (pursuers > 1 or evaders > 1) and not sim.teams:
+        raise ConfigError(
+            f"Invalid value for 'team': {team}, but the simulator {sim.__name__} plays "
+            "one pursuer and one evader. Allowed: team.pursuers=1 team.evaders=1, or a "
+            "simulator that plays teams (sim=grid)."
+        )
+    if evaders > 1 and not detector.identifies:
+        raise ConfigError(
+            f"Invalid value for 'team.evaders': {evaders}, but the detector "
+            f"{detector.__name__} cannot tell evaders apart. Allowed: team.evaders=1, "
+            "or a detector that identifies the evader it saw (detector=oracle)."
+        )

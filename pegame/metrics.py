@@ -5,15 +5,32 @@ reports the evader (paper, Table 1: "tracking success rate"). A *loss* is a maxi
 ticks without a detection; it ends in a *reacquisition* when a detection follows. The
 visible rate is the fraction of ticks at which any part of the evader's body is in the
 pursuer's view (:func:`pegame.visibility.body_in_view`), the ground truth beside it.
+
+Teams (:class:`TeamMetrics`): evader j counts as detected at a tick when at least one
+pursuer detects it, and as in view when it is in some pursuer's view; ``tracking_rate``
+is the mean over the M evaders of their fractions of detected ticks (for one pursuer
+and one evader exactly the 1v1 value), and every other per-evader measure is the mean
+over the evaders (distances to the nearest pursuer). Beside them: the per-evader and
+per-pursuer tracking rates (a pursuer's: the fraction of ticks it detects some evader),
+*handoffs* (an evader's custody passing straight from one pursuer to another: its
+tracker, the pursuer that has detected it since the others lost it, stops detecting it
+while another pursuer does, or the tracker loses it in the very tick another takes it),
+and the team's *coverage*, the mean fraction of the map's free cells inside the union of
+the pursuers' regions, sampled at decision ticks.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pegame.types import Belief, Pose
+from pegame.types import Belief, Detection, Pose, Region
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from pegame.api import Context
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
@@ -97,3 +114,94 @@ class TrackingMetrics:
             "n_eff_min": _rounded(min(self.n_eff)) if self.n_eff else None,
             "resamplings": self.resamplings,
         }
+
+
+class TeamMetrics:
+    """Accumulates a team game (module docstring) tick by tick; ``summary()`` gives the
+    result's measures, the 1v1 keys (means over the evaders) and the team's.
+
+    context: the game's; pursuers, evaders: the team sizes N and M.
+    """
+
+    def __init__(self, context: Context, pursuers: int, evaders: int) -> None:
+        self.dt = context.control_dt
+        self.free = ~context.grid.blocked
+        self.free_cells = max(1, int(self.free.sum()))
+        self.per_evader = [TrackingMetrics(self.dt) for _ in range(evaders)]
+        self.pursuer_paths: list[list[tuple[float, float]]] = [[] for _ in range(pursuers)]
+        self.pursuer_detected = [0] * pursuers
+        self.ticks = 0
+        self.trackers: list[int | None] = [None] * evaders
+        self.handoffs = 0
+        self.coverage: list[float] = []
+
+    @property
+    def detected(self) -> list[bool]:
+        """Per tick: whether some evader was detected by some pursuer."""
+        columns = [m.detected for m in self.per_evader]
+        return [any(flags) for flags in zip(*columns)]
+
+    def add(
+        self,
+        pursuers: Sequence[Pose],
+        evaders: Sequence[Pose],
+        detections: Sequence[Sequence[Detection | None]],
+        in_view: Sequence[Sequence[bool]],
+        beliefs: Sequence[Belief],
+        union: Region | None = None,
+    ) -> None:
+        """Record one control tick: true poses, detections[i][j] and in_view[i][j] of
+        pursuer i and evader j, the beliefs per evader and, when given, the union of the
+        pursuers' regions (a coverage sample)."""
+        self.ticks += 1
+        for i, pose in enumerate(pursuers):
+            self.pursuer_paths[i].append((pose.x, pose.y))
+            self.pursuer_detected[i] += any(d is not None for d in detections[i])
+        for j, (evader, metrics) in enumerate(zip(evaders, self.per_evader)):
+            seers = [i for i, row in enumerate(detections) if row[j] is not None]
+            near = min(range(len(pursuers)), key=lambda i: pursuers[i].distance_to(evader))
+            seen_in_view = any(row[j] for row in in_view)
+            metrics.add(pursuers[near], evader, bool(seers), seen_in_view, beliefs[j])
+            self.handoffs += self._hand(j, seers)
+        if union is not None:
+            self.coverage.append(float(np.count_nonzero(union.mask & self.free)) / self.free_cells)
+
+    def _hand(self, j: int, seers: list[int]) -> int:
+        """Update evader j's tracker from this tick's ``seers``; 1 for a handoff."""
+        tracker = self.trackers[j]
+        if not seers:
+            self.trackers[j] = None
+            return 0
+        if tracker in seers:
+            return 0
+        self.trackers[j] = seers[0]
+        return int(tracker is not None)
+
+    @property
+    def tracking_rate(self) -> float:
+        """Mean over the evaders of their fractions of ticks so far detected by some pursuer."""
+        return float(np.mean([m.tracking_rate for m in self.per_evader]))
+
+    def summary(self) -> dict[str, float | int | list | None]:
+        """The 1v1 measures as means over the evaders, then the team's (module docstring)."""
+        summaries = [m.summary() for m in self.per_evader]
+        result: dict[str, float | int | list | None] = {}
+        for key in summaries[0]:
+            values = [s[key] for s in summaries if s[key] is not None]
+            result[key] = _rounded(np.mean(values)) if values else None
+        ticks = max(1, self.ticks)
+        result["tracking_rate"] = _rounded(self.tracking_rate)
+        result["pursuer_path_length"] = _rounded(
+            np.mean([_path_length(np.asarray(p)) for p in self.pursuer_paths])
+        )
+        result.update(
+            {
+                "pursuers": len(self.pursuer_paths),
+                "evaders": len(self.per_evader),
+                "tracking_rate_per_evader": [s["tracking_rate"] for s in summaries],
+                "tracking_rate_per_pursuer": [_rounded(n / ticks) for n in self.pursuer_detected],
+                "handoffs": self.handoffs,
+                "coverage": _rounded(np.mean(self.coverage)) if self.coverage else None,
+            }
+        )
+        return result

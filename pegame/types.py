@@ -9,7 +9,7 @@ imports another pegame module but :mod:`pegame.errors`, so every module can impo
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -144,6 +144,10 @@ class SensorFrame:
     down, z forward; m) to the map frame with z up and the floor at z = 0 (it holds the
     camera's height and tilt); labels, segmentation values by name (e.g. ``"evader"``),
     for simulator-side detectors only.
+
+    In a team game every pursuer's camera delivers its own frame: evaders_truth holds
+    every evader's true pose (evader_truth is the one a detector is asked about, evader 0
+    unless the tick loop asked about another, :meth:`about`).
     """
 
     time: float
@@ -155,6 +159,16 @@ class SensorFrame:
     intrinsics: np.ndarray | None = None
     camera_to_map: np.ndarray | None = None
     labels: dict[str, int] | None = None
+    evaders_truth: tuple[Pose, ...] | None = None
+
+    def about(self, evader: int) -> SensorFrame:
+        """This frame with ``evader_truth`` set to evader ``evader``'s true pose (a team
+        frame; the frame itself for evader 0 of a frame without ``evaders_truth``)."""
+        if self.evaders_truth is None:
+            if evader != 0:
+                raise ValueError(f"This frame holds one evader; evader {evader} is not in it.")
+            return self
+        return replace(self, evader_truth=self.evaders_truth[evader])
 
 
 @dataclass(frozen=True)
@@ -163,12 +177,15 @@ class Detection:
 
     box: image bounding box (px); depth: range along the optical axis to the evader (m);
     position: the evader's estimated (x, y) in the map frame (m); confidence in [0, 1].
+    evader: the index of the evader seen, when the detector can tell (a team game's
+    simulator-side detectors can; None: unknown, or the only evader of a 1v1 game).
     """
 
     box: BoundingBox
     depth: float
     position: tuple[float, float]
     confidence: float = 1.0
+    evader: int | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -41,3 +41,11 @@ def test_report_text_shows_missing_figures_as_dashes():
     )
     text = format_report(report)
     assert "machine:" in text and "S-S -" in text and "recorder: +-% game time" in text
+
+
+def test_team_scaling_times_a_game_of_every_team_size(tmp_path):
+    from pegame.bench import TEAM_SIZES, team_scaling
+
+    seconds = team_scaling(1, str(tmp_path), t_max=1.0)
+    assert list(seconds) == [f"{n}v{m}" for n, m in TEAM_SIZES]
+    assert all(value > 0 for value in seconds.values())

@@ -125,4 +125,4 @@ def test_the_schema_has_one_node_per_plugin_kind():
 
     names = [f.name for f in fields(Schema)]
     assert [n for n in names if n in PLUGIN_KINDS] == list(PLUGIN_KINDS)
-    assert set(names) - set(PLUGIN_KINDS) == {"game", "camera", "env", "resume"}
+    assert set(names) - set(PLUGIN_KINDS) == {"game", "camera", "env", "team", "resume"}

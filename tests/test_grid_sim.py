@@ -141,10 +141,10 @@ def test_a_wall_stops_the_forward_speed_and_keeps_the_turn_rate():
     sim.reset(Pose(1.0, 1.5, 0.0), Pose(3.5, 2.5))  # heading at the pillar's left face
     for _ in range(40):
         sim.step(Velocity(0.5, 0.0), Velocity(), DT)
-    assert sim._pursuer.velocity == Velocity(0.0, 0.0)
+    assert sim._pursuers[0].velocity == Velocity(0.0, 0.0)
     at_wall = sim.poses[0]
     sim.step(Velocity(0.5, 1.0), Velocity(), DT)  # still pressed against the wall, turning
-    assert sim._pursuer.velocity == Velocity(0.0, pytest.approx(0.2))
+    assert sim._pursuers[0].velocity == Velocity(0.0, pytest.approx(0.2))
     assert sim.poses[0].theta == pytest.approx(at_wall.theta + 0.2 * DT)
 
 
@@ -154,9 +154,9 @@ def test_step_one_moves_one_agent_and_pauses_the_other():
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
     sim.reset(Pose(1.0, 1.0, 0.0), Pose(3.0, 2.5, 0.0))
     sim.step(Velocity(0.5, 0.0), Velocity(0.5, 0.0), DT)
-    pursuer, evader, paused = *sim.poses, sim._evader.velocity
+    pursuer, evader, paused = *sim.poses, sim._evaders[0].velocity
     sim.step_one("pursuer", Velocity(0.5, 0.0), DT)
-    assert sim.poses[1] == evader and sim._evader.velocity == paused
+    assert sim.poses[1] == evader and sim._evaders[0].velocity == paused
     assert sim.poses[0].x > pursuer.x
     sim.step_one("evader", Velocity(0.5, 0.0), DT)
     assert sim.poses[1].x == pytest.approx(evader.x + 0.2 * DT)  # resumed from its kept 0.1 m/s

@@ -182,7 +182,7 @@ def test_speed_and_turn_rate_change_at_most_a_max_dt_per_step(seed, dt):
     grid = room()
     sim.reset(Pose(*grid.cell_to_world(10, 10)), Pose(*grid.cell_to_world(50, 70)))
     rng = np.random.default_rng(seed)
-    agent = sim._pursuer
+    agent = sim._pursuers[0]
     for _ in range(100):
         before = agent.velocity
         sim.step(Velocity(*rng.uniform(-1.0, 1.0, 2) * [1.0, 4.0]), Velocity(), dt)

@@ -36,6 +36,7 @@ class OracleDetector(Detector):
     """Ground-truth visibility with a synthetic pinhole bounding box."""
 
     description = "Geometric detection (FOV, range, line of sight) with a synthetic pinhole box."
+    identifies = True  # it looks for frame.evader_truth only: in a team it names its evader
 
     @dataclass
     class Config(PerceptionConfig):

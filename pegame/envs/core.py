@@ -8,6 +8,10 @@ evader, the evader the negative (zero-sum). The game ends after ``game.t_max`` s
 last step is a truncation (there is no terminal state); a last step may be shorter when
 t_max is not a whole number of decision periods.
 
+Teams (``team.pursuers``, ``team.evaders``): one agent per member (:class:`EnvGame`); the
+pursuers share the team's reward, +1 per control tick for every evader some pursuer
+detects, and each evader gets -1 per tick that it is detected.
+
 Infos: ``seed`` (the game's master seed; ``python -m pegame game.seed=<seed>`` with
 the same strategies replays it) after reset; ``time`` (s) and ``tracking_rate`` (the
 fraction of the ticks played so far with the evader detected, as in the game's result)
@@ -26,7 +30,7 @@ from pegame.envs.actions import to_velocity
 from pegame.envs.observations import EvaderFeatures, PursuerFeatures
 from pegame.envs.settings import EnvSettings
 from pegame.game import Scenario
-from pegame.loop import TickLoop
+from pegame.loop import TickLoop, nearest
 
 
 def check_seed(seed: int | None) -> int | None:
@@ -47,7 +51,13 @@ class EnvGame:
     """The learning ``roles`` (a subset of ('pursuer', 'evader')) in games of ``cfg``, one
     game at a time: ``reset(seed)`` builds the scenario's game with that master seed (the
     game ``python -m pegame game.seed=<seed>`` plays) and ``step`` drives its tick loop,
-    the learners' roles commanded from outside."""
+    the learners' roles commanded from outside.
+
+    Agents: a learning role is one agent named by the role in a 1v1 game, and one agent
+    per member, ``pursuer_0``, ``pursuer_1``, ... (``evader_0``, ...), in a team game
+    (``team.pursuers``, ``team.evaders``). Pursuer i observes its own pose and the team's
+    belief about its target evader (i mod M); evader j its pose and its nearest pursuer.
+    """
 
     def __init__(self, cfg: DictConfig, settings: EnvSettings, roles: Sequence[str]) -> None:
         self.settings = settings
@@ -60,6 +70,22 @@ class EnvGame:
             "evader": EvaderFeatures(context, settings.observation),
         }
         self.bodies = {"pursuer": context.pursuer, "evader": context.evader}
+        sizes = dict(zip(("pursuer", "evader"), self.scenario.team_size))
+        solo = self.scenario.team_size == (1, 1)
+        #: the learning agents per role, in member order
+        self.members = {
+            role: [role] if solo else [f"{role}_{k}" for k in range(sizes[role])]
+            for role in self.roles
+        }
+        self.agents = [agent for role in self.roles for agent in self.members[role]]
+        self.member_features = {
+            agent: self.features[role]
+            if solo
+            else type(self.features[role])(context, settings.observation)
+            for role in self.roles
+            for agent in self.members[role]
+        }
+        self.evader_detections = [0] * sizes["evader"]  # in the last step, per evader
         self.seed: int | None = None
         self.loop: TickLoop | None = None
 
@@ -73,37 +99,43 @@ class EnvGame:
         self.close()
         self.seed = seed
         self.loop = self.scenario.game(seed).start(self.roles, estimate=self.settings.belief)
-        for role in self.roles:
-            self.features[role].reset()
+        for features in self.member_features.values():
+            features.reset()
         self._remember()
         return self.observations()
 
     def step(self, actions: Mapping[str, object]) -> tuple[dict[str, np.ndarray], float, bool]:
-        """Apply the learners' ``actions`` (role -> scaled (v, w)) for one decision period.
+        """Apply the learners' ``actions`` (agent -> scaled (v, w)) for one decision period.
 
-        Returns the new observations, the pursuer's reward (the evader's is its negative)
-        and whether the game is over. Every action is checked before anything moves.
+        Returns the new observations, the pursuers' reward (the evaders' together is its
+        negative: the ticks at which each evader is detected by some pursuer, summed over
+        the evaders; per evader in ``evader_detections``) and whether the game is over.
+        Every action is checked before anything moves.
         """
         loop = self.loop
         if loop is None or loop.done:
             raise RuntimeError("No game in progress: call reset() before step().")
         commands = self._commands(actions)
-        detections = 0
+        detections = [0] * len(self.evader_detections)
         for _ in range(self.ticks_per_action):
             loop.advance(commands)
-            detections += loop.detection is not None
+            for j in range(len(detections)):
+                detections[j] += any(row[j] is not None for row in loop.detections)
             self._remember()
             if loop.done:
                 break
-        return self.observations(), float(detections), loop.done
+        self.evader_detections = detections
+        return self.observations(), float(sum(detections)), loop.done
 
     def observations(self) -> dict[str, np.ndarray]:
-        """Each learner's observation at the current tick (new arrays)."""
+        """Each learning agent's observation at the current tick (new arrays)."""
         loop, out = self.loop, {}
-        if "pursuer" in self.roles:
-            out["pursuer"] = self.features["pursuer"].build(loop.time, loop.pursuer, loop.belief)
-        if "evader" in self.roles:
-            out["evader"] = self.features["evader"].build(loop.evader, loop.pursuer)
+        for i, agent in enumerate(self.members.get("pursuer", ())):
+            belief = loop.beliefs[i % len(loop.beliefs)]
+            out[agent] = self.member_features[agent].build(loop.time, loop.pursuers[i], belief)
+        for j, agent in enumerate(self.members.get("evader", ())):
+            near = nearest(loop.pursuers, loop.evaders[j])
+            out[agent] = self.member_features[agent].build(loop.evaders[j], loop.pursuers[near])
         return out
 
     def info(self) -> dict:
@@ -115,25 +147,30 @@ class EnvGame:
         return info
 
     def _remember(self) -> None:
-        if "pursuer" in self.roles:
-            self.features["pursuer"].remember(self.loop.time, self.loop.detection)
+        loop = self.loop
+        for i, agent in enumerate(self.members.get("pursuer", ())):
+            detection = loop.detections[i][i % len(loop.evaders)]
+            self.member_features[agent].remember(loop.time, detection)
 
     def _commands(self, actions: Mapping[str, object]) -> dict:
         if not isinstance(actions, Mapping):
             raise ValueError(
-                f"actions must map each agent in {list(self.roles)} to its action, got {actions!r}."
+                f"actions must map each agent in {self.agents} to its action, got {actions!r}."
             )
-        unknown = sorted(set(actions) - set(self.roles))
-        missing = [role for role in self.roles if role not in actions]
+        unknown = sorted(set(actions) - set(self.agents))
+        missing = [agent for agent in self.agents if agent not in actions]
         if unknown or missing:
             raise ValueError(
-                f"actions must have exactly the agents {list(self.roles)}; "
+                f"actions must have exactly the agents {self.agents}; "
                 f"missing {missing}, unexpected {unknown}."
             )
         return {
-            role: to_velocity(
-                actions[role], self.bodies[role], self.settings.clip_actions, f"{role} action"
-            )
+            role: [
+                to_velocity(
+                    actions[agent], self.bodies[role], self.settings.clip_actions, f"{agent} action"
+                )
+                for agent in self.members[role]
+            ]
             for role in self.roles
         }
 

@@ -1,6 +1,9 @@
-"""The two-agent PettingZoo environment: a learning pursuer against a learning evader.
+"""The PettingZoo environment: learning pursuers against learning evaders.
 
-Agents ``pursuer`` and ``evader`` act simultaneously (PettingZoo's Parallel API).
+Agents ``pursuer`` and ``evader`` act simultaneously (PettingZoo's Parallel API); in a
+team game (``team.pursuers=N``, ``team.evaders=M`` in the overrides or config) the agents
+are ``pursuer_0`` .. ``pursuer_{N-1}`` and ``evader_0`` .. ``evader_{M-1}``, every pursuer
+with the team's reward and every evader with its own (:mod:`pegame.envs.core`).
 Spaces, per agent: ``Box(-1, 1, (2,), float32)`` actions (v, w) scaled to the agent's
 limits (:mod:`pegame.envs.actions`) and a flat float32 ``Box`` observation
 (:mod:`pegame.envs.observations`; ``env.layouts[agent]`` names its parts). Rewards,
@@ -40,15 +43,18 @@ class PursuitEvasionParallelEnv(ParallelEnv):
     ) -> None:
         self.settings = env_settings(**settings)
         self.game = EnvGame(env_config(config, overrides), self.settings, ROLES)
-        self.possible_agents = list(ROLES)
+        self.possible_agents = list(self.game.agents)
         self.agents: list[str] = []
         features = self.game.features
-        self.layouts = {role: features[role].layout for role in ROLES}
+        self.roles = {agent: role for role in ROLES for agent in self.game.members[role]}
+        self.layouts = {agent: features[role].layout for agent, role in self.roles.items()}
         self.observation_spaces = {
-            role: spaces.Box(features[role].low, features[role].high, dtype=np.float32)
-            for role in ROLES
+            agent: spaces.Box(features[role].low, features[role].high, dtype=np.float32)
+            for agent, role in self.roles.items()
         }
-        self.action_spaces = {role: spaces.Box(-1.0, 1.0, (2,), np.float32) for role in ROLES}
+        self.action_spaces = {
+            agent: spaces.Box(-1.0, 1.0, (2,), np.float32) for agent in self.possible_agents
+        }
         self._np_random: np.random.Generator | None = None
 
     def observation_space(self, agent: str) -> spaces.Box:
@@ -63,17 +69,20 @@ class PursuitEvasionParallelEnv(ParallelEnv):
         if seed is not None or self._np_random is None:
             self._np_random = np.random.default_rng(check_seed(seed))
         obs = self.game.reset(game_seed(seed, self._np_random))
-        self.agents = list(ROLES)
-        return obs, {role: {"seed": self.game.seed} for role in ROLES}
+        self.agents = list(self.possible_agents)
+        return obs, {agent: {"seed": self.game.seed} for agent in self.agents}
 
     def step(self, actions: dict[str, np.ndarray]):
-        """One decision period with both agents' actions (ValueError for a bad one)."""
+        """One decision period with every agent's action (ValueError for a bad one)."""
         obs, reward, done = self.game.step(actions)
-        rewards = {"pursuer": reward, "evader": -reward}
-        infos = {role: self.game.info() for role in ROLES}
+        rewards = dict.fromkeys(self.game.members["pursuer"], reward)
+        for j, agent in enumerate(self.game.members["evader"]):
+            rewards[agent] = -float(self.game.evader_detections[j])
+        agents = self.possible_agents
+        infos = {agent: self.game.info() for agent in agents}
         if done:
             self.agents = []
-        return obs, rewards, dict.fromkeys(ROLES, False), dict.fromkeys(ROLES, done), infos
+        return obs, rewards, dict.fromkeys(agents, False), dict.fromkeys(agents, done), infos
 
     def close(self) -> None:
         self.game.close()

@@ -20,7 +20,8 @@ direction). This is a projection onto the feasible set, not a Bayesian update; t
 covariance is left as the filter computed it.
 
 The filter starts at the first detection (position = detection, velocity 0 with std
-v_max); before it the belief's mean is None.
+v_max); before it the belief's mean is None. In a team every pursuer's detection of the
+evader corrects the filter in turn (:meth:`KalmanEstimator.update_team`).
 """
 
 from __future__ import annotations
@@ -85,6 +86,32 @@ class KalmanEstimator(Estimator):
             kf.update(np.asarray(detection.position, dtype=float))
             self._clamp_speed()
         return self._belief()
+
+    def reset_team(self, pursuers, detections, region) -> Belief:
+        """Forget the track; start one at the first detection and correct it with the others."""
+        self._kf = None
+        seen = [d for d in detections if d is not None]
+        if seen:
+            self._start(seen[0].position)
+            self._correct(seen[1:])
+        return self._belief()
+
+    def update_team(self, dt, pursuers, detections, region) -> Belief:
+        """Predict ``dt`` s ahead, then correct with every pursuer's detection in turn
+        (independent measurements of one position: sequential updates are the batch
+        update)."""
+        seen = [d for d in detections if d is not None]
+        if self._kf is None:
+            return self.reset_team(pursuers, detections, region)
+        self.update(dt, pursuers[0], seen[0] if seen else None, region)
+        self._correct(seen[1:])
+        return self._belief()
+
+    def _correct(self, detections) -> None:
+        """Kalman updates with each of ``detections``' map positions, speed clamped."""
+        for detection in detections:
+            self._kf.update(np.asarray(detection.position, dtype=float))
+            self._clamp_speed()
 
     def _start(self, position: tuple[float, float]) -> None:
         """A filter at ``position`` (m), at rest, with the velocity's std v_max (m/s)."""

@@ -52,21 +52,37 @@ Units and frames: metres, seconds and radians in the map frame of :mod:`pegame.g
 
 The argmin is :class:`pegame.evaders.escape.EscapeSearch`'s: numba kernels that skip
 most of the candidates, held bit for bit to a plain numpy reference.
+
+Against a team of pursuers (``EvaderObservation.pursuers`` holds more than one pose) V is
+the union of their regions (``pursuer_region``) and cost_dist the distance from each
+candidate to its nearest pursuer, ``min_k dist(p_k, c)``: a hiding place next to another
+pursuer is no escape. That argmin is :meth:`SmartEvader.team_escape`, in plain numpy over
+every candidate (it is the 1v1 reference with the minimum over the pursuers).
 """
 
 from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import distance_transform_edt
 
 from pegame.api import Evader, EvaderObservation
 from pegame.errors import require
-from pegame.evaders.escape import DISTANCES, EscapeSearch
+from pegame.evaders.escape import (
+    DISTANCES,
+    MAX_RECORDED_CANDIDATES,
+    Escape,
+    EscapeSearch,
+    escape_costs,
+    subsample,
+)
 from pegame.navigation import PathFollower, Planner
-from pegame.types import STOP, Plan, Pose, Velocity
+from pegame.types import STOP, Plan, Pose, Region, Velocity
+from pegame.visibility import UnionRegion, VisibilityRegion
 
 log = logging.getLogger(__name__)
 
@@ -133,7 +149,10 @@ class SmartEvader(Evader):
         cost of this decision's argmin (+inf when there is no candidate).
         """
         me, pursuer = observation.pose, observation.pursuer
-        found = self.search.escape(me, pursuer, observation.pursuer_region)
+        if len(observation.pursuers) > 1:
+            found = self.team_escape(me, observation.pursuers, observation.pursuer_region)
+        else:
+            found = self.search.escape(me, pursuer, observation.pursuer_region)
         if found.count == 0:
             log.info(
                 "t=%.2f s: the pursuer's view covers all free space the evader can reach; "
@@ -159,6 +178,61 @@ class SmartEvader(Evader):
         }
         self.plan = Plan(goal, path, info)
         return self.plan
+
+    def team_escape(
+        self, me: Pose, pursuers: Sequence[Pose], visible: Region | None = None
+    ) -> Escape:
+        """Algorithm 2 against a team (module docstring): the candidates outside the union
+        ``visible`` of the pursuers' regions (computed from ``pursuers`` when not given)
+        grown by the hide margin, cost_dist the distance to the nearest pursuer. Plain
+        numpy over every candidate, as :meth:`EscapeSearch.escape_reference`; with every
+        pursuer at one pose it is that pose's 1v1 argmin."""
+        search, grid = self.search, self.context.grid
+        if visible is None:
+            visible = UnionRegion(
+                [VisibilityRegion(grid, pose, self.context.camera) for pose in pursuers]
+            )
+        exposed = self._grown(visible)
+        stride = self.config.candidate_stride
+        mask = self.planner.reachable((me.x, me.y)) & ~exposed
+        mask[np.arange(grid.height) % stride != 0, :] = False
+        mask[:, np.arange(grid.width) % stride != 0] = False
+        cells = np.flatnonzero(mask)
+        if cells.size == 0:
+            return Escape(-1, math.inf, 0, cells)
+        if self.config.distance == "euclidean":
+            x, y = search.centres[cells].T
+            effort = np.sqrt((x - me.x) ** 2 + (y - me.y) ** 2)
+            dist = np.min([np.sqrt((x - p.x) ** 2 + (y - p.y) ** 2) for p in pursuers], axis=0)
+        else:
+            effort = self.planner.distance_field((me.x, me.y)).ravel()[cells]
+            fields = [search.pursuer_planner.distance_field((p.x, p.y)).ravel() for p in pursuers]
+            dist = np.min([f[cells] for f in fields], axis=0)
+        cost = escape_costs(effort, dist)
+        best = int(np.argmin(cost))  # first minimum: the lowest row-major index among ties
+        return Escape(
+            int(cells[best]),
+            float(cost[best]),
+            cells.size,
+            subsample(cells, MAX_RECORDED_CANDIDATES),
+        )
+
+    def _grown(self, visible: Region) -> np.ndarray:
+        """Bool (H, W): the cells within the hide margin (m) of ``visible``, by the
+        Euclidean distance transform (as the 1v1 reference grows V), computed over V's
+        bounds padded by the margin: no cell farther out can be that close."""
+        mask, margin = visible.mask, self.config.hide_margin
+        r0, r1, c0, c1 = visible.bounds
+        if margin <= 0 or r1 <= r0:
+            return mask
+        grid = self.context.grid
+        pad = math.ceil(margin / grid.resolution) + 1
+        r0, c0 = max(r0 - pad, 0), max(c0 - pad, 0)
+        r1, c1 = min(r1 + pad, grid.height), min(c1 + pad, grid.width)
+        grown = np.zeros(mask.shape, dtype=bool)
+        window = distance_transform_edt(~mask[r0:r1, c0:c1]) * grid.resolution <= margin
+        grown[r0:r1, c0:c1] = window
+        return grown
 
     def control(self, observation: EvaderObservation) -> Velocity:
         return self.follower.command(observation.pose) if self.plan.goal is not None else STOP

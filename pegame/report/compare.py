@@ -4,8 +4,9 @@ A *factor* is a setting that differs between a sweep's configurations (see
 :mod:`pegame.report.cells`), e.g. ``detector.miss_probability``. :func:`compare` takes
 every cell of the paper's layout (environment x speed ratio v_p/v_e x pairing, and each
 combination of the sweep's *other* factors) where both values A and B of the factor have
-games, and compares B against A on the seeds they share (same seed, same spawn poses):
-n pairs, the mean of each side on those seeds, the mean difference B - A with its
+games (the factor may also be one of the paper's axes, e.g. ``pairing=S-S,cooperative-S``
+for two pursuers in otherwise equal cells), and compares B against A on the seeds they
+share (same seed, same spawn poses): n pairs, the mean of each side on those seeds, the mean difference B - A with its
 percentile-bootstrap CI over seeds, the rank-biserial correlation, and the two-sided
 Wilcoxon signed-rank test (Pratt's zeros, see :mod:`pegame.report.paired`),
 Holm-Bonferroni corrected across the comparison's tested cells. Rates are fractions in
@@ -25,7 +26,7 @@ import re
 from typing import Any
 
 from pegame.errors import PegameError
-from pegame.report.cells import Cell, value_text
+from pegame.report.cells import AXES, Cell, value_text
 from pegame.report.paired import TEST_NAME, by_seed, difference_text, paired_test
 from pegame.report.statistics import ALPHA, holm
 from pegame.report.tables import csv_value, percent
@@ -69,16 +70,23 @@ def file_stem(factor: str) -> str:
     return "compare_" + re.sub(r"[^\w.-]", "_", factor)
 
 
+def cell_value(cell: Cell, factor: str) -> Any:
+    """The cell's value of ``factor``: a paper axis (map, speed_ratio, pairing) or another
+    factor."""
+    return getattr(cell, factor) if factor in AXES else cell.factors[factor]
+
+
 def check(cells: list[Cell], factor: str, values: tuple[str, str]) -> None:
-    """Raise :class:`CompareError` unless ``factor`` is a factor of ``cells`` with both
-    ``values``."""
+    """Raise :class:`CompareError` unless ``factor`` is a factor of ``cells`` (or a paper
+    axis) with both ``values``."""
     factors = list(cells[0].factors) if cells else []
-    if factor not in factors:
+    if factor not in factors and factor not in AXES:
         raise CompareError(
             f"--compare: {factor!r} is not a factor of this sweep (a setting that differs "
-            f"between its configurations). Its factors: {', '.join(factors) or 'none'}."
+            f"between its configurations) nor a paper axis ({', '.join(AXES)}). Its "
+            f"factors: {', '.join(factors) or 'none'}."
         )
-    seen = sorted({value_text(c.factors[factor]) for c in cells})
+    seen = sorted({value_text(cell_value(c, factor)) for c in cells})
     absent = [v for v in values if v not in seen]
     if absent:
         raise CompareError(
@@ -101,10 +109,11 @@ def compare(cells: list[Cell], factor: str, a: str, b: str) -> dict[str, Any]:
 
     def place(cell: Cell) -> tuple:
         rest = tuple(cell.facet[i] for i, f in enumerate(cell.factors) if f != factor)
-        return cell.map, cell.speed_ratio, cell.pairing, rest
+        axes = tuple(getattr(cell, axis) for axis in AXES if axis != factor)
+        return axes, rest
 
     sides = {
-        value: {place(c): c for c in cells if value_text(c.factors[factor]) == value}
+        value: {place(c): c for c in cells if value_text(cell_value(c, factor)) == value}
         for value in (a, b)
     }
     rows = []
@@ -113,11 +122,12 @@ def compare(cells: list[Cell], factor: str, a: str, b: str) -> dict[str, Any]:
         if cell_b is None:
             continue
         test = paired_test(by_seed(cell_b.games), by_seed(cell_a.games), "two-sided")
+        axes = {axis: getattr(cell_a, axis) for axis in AXES}
+        if factor in AXES:  # the compared axis: both of its values
+            axes[factor] = f"{value_text(getattr(cell_a, factor))} vs {b}"
         rows.append(
             {
-                "map": cell_a.map,
-                "speed_ratio": cell_a.speed_ratio,
-                "pairing": cell_a.pairing,
+                **axes,
                 "factors": {f: cell_a.factors[f] for f in others},
                 "n_a": len(cell_a.games),
                 "n_b": len(cell_b.games),
@@ -192,7 +202,7 @@ def render_compare_md(comparison: dict[str, Any]) -> str:
         texts = [
             *(value_text(v) for v in row["factors"].values()),
             row["map"],
-            f"{row['speed_ratio']:g}",
+            value_text(row["speed_ratio"]),
             row["pairing"],
             f"{row['n_pairs']} (of {row['n_a']}, {row['n_b']})",
             percent(row["mean_a"]),

@@ -1,4 +1,5 @@
-"""The built-in 2D simulator: two unicycles on the occupancy grid.
+"""The built-in 2D simulator: unicycles on the occupancy grid (one pursuer and one evader, or
+teams of them).
 
 State x = (x, y, theta) in the map frame and the current velocity (v, w); a command (v, w)
 is saturated to the agent's limits, its change from the current velocity is limited to
@@ -6,7 +7,8 @@ is saturated to the agent's limits, its change from the current velocity is limi
 command at once) and the result is integrated exactly over dt (arc motion). An agent never enters a cell of the
 grid inflated by its radius (:func:`pegame.navigation.inflate`): a move that would enter
 one is cut at the last free sample, so the agent stops at the wall and may still turn.
-The agents do not collide with each other (the paper's agents never need to touch).
+The agents do not collide with each other (the paper's agents never need to touch; the
+spawn starts them apart).
 
 The swept collision check is a numba kernel (:func:`_sweep`); ``_sweep_reference`` is the
 plain-Python loop it reproduces, which the tests compare it against.
@@ -121,9 +123,11 @@ class _Agent:
 
 class GridSimulator(Simulator):
     """Kinematic unicycles on the occupancy grid, stopped by walls; the camera frame
-    carries the ground-truth evader pose for the oracle detector."""
+    carries the ground-truth evader pose for the oracle detector. Plays teams: N
+    pursuers and M evaders, each pursuer with its own camera frame."""
 
     description = "2D kinematic unicycles on the occupancy grid; agents stop at walls."
+    teams = True
 
     @dataclass
     class Config:
@@ -131,29 +135,65 @@ class GridSimulator(Simulator):
 
     def __init__(self, config, context, rng) -> None:
         super().__init__(config, context, rng)
-        self._pursuer = _Agent(context.grid, context.pursuer)
-        self._evader = _Agent(context.grid, context.evader)
+        self._pursuers = [_Agent(context.grid, context.pursuer)]
+        self._evaders = [_Agent(context.grid, context.evader)]
 
     def reset(self, pursuer: Pose, evader: Pose) -> None:
-        for agent, pose in ((self._pursuer, pursuer), (self._evader, evader)):
-            if agent.collides(pose.x, pose.y):
-                raise ValueError(
-                    f"start pose {pose} is inside an obstacle for radius {agent.body.radius} m"
-                )
-            agent.pose, agent.velocity = pose, STOP
+        self.reset_team((pursuer,), (evader,))
+
+    def reset_team(self, pursuers, evaders) -> None:
+        context = self.context
+        for agents, poses, body in (
+            (self._pursuers, pursuers, context.pursuer),
+            (self._evaders, evaders, context.evader),
+        ):
+            while len(agents) < len(poses):  # the masks are shared: an agent costs little
+                agents.append(_Agent(context.grid, body))
+            del agents[len(poses) :]
+            for agent, pose in zip(agents, poses):
+                if agent.collides(pose.x, pose.y):
+                    raise ValueError(
+                        f"start pose {pose} is inside an obstacle for radius {agent.body.radius} m"
+                    )
+                agent.pose, agent.velocity = pose, STOP
 
     def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
-        self._pursuer.move(pursuer_cmd, dt)
-        self._evader.move(evader_cmd, dt)
+        self._pursuers[0].move(pursuer_cmd, dt)
+        self._evaders[0].move(evader_cmd, dt)
+
+    def step_team(self, pursuer_cmds, evader_cmds, dt: float) -> None:
+        for agent, cmd in zip(self._pursuers, pursuer_cmds):
+            agent.move(cmd, dt)
+        for agent, cmd in zip(self._evaders, evader_cmds):
+            agent.move(cmd, dt)
 
     def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
-        (self._pursuer if role == "pursuer" else self._evader).move(cmd, dt)
+        (self._pursuers if role == "pursuer" else self._evaders)[0].move(cmd, dt)
+
+    def step_team_one(self, role: str, cmds, dt: float) -> None:
+        for agent, cmd in zip(self._pursuers if role == "pursuer" else self._evaders, cmds):
+            agent.move(cmd, dt)
 
     @property
     def poses(self) -> tuple[Pose, Pose]:
-        return self._pursuer.pose, self._evader.pose
+        return self._pursuers[0].pose, self._evaders[0].pose
+
+    @property
+    def team_poses(self) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
+        return tuple(a.pose for a in self._pursuers), tuple(a.pose for a in self._evaders)
 
     def sense(self, time: float) -> SensorFrame:
         return SensorFrame(
-            time=time, camera_pose=self._pursuer.pose, evader_truth=self._evader.pose
+            time=time, camera_pose=self._pursuers[0].pose, evader_truth=self._evaders[0].pose
+        )
+
+    def sense_team(self, time: float) -> tuple[SensorFrame, ...]:
+        if len(self._pursuers) == 1 and len(self._evaders) == 1:
+            return (self.sense(time),)
+        evaders = tuple(a.pose for a in self._evaders)
+        return tuple(
+            SensorFrame(
+                time=time, camera_pose=a.pose, evader_truth=evaders[0], evaders_truth=evaders
+            )
+            for a in self._pursuers
         )

@@ -52,6 +52,7 @@ from pegame.recorders.rerun.scene import (
     log_static,
     log_trails,
 )
+from pegame.recorders.rerun.team import buffer_team
 
 log = logging.getLogger(__name__)
 
@@ -245,6 +246,7 @@ class RerunRecorder(Recorder):
             self._particles.add(tick.step, tick.time, tick.belief.particles, tick.belief.weights)
         self._log_plans(tick)
         self._log_detection_events(tick)
+        buffer_team(self._buffers, tick, self.context, self.config.max_particles)
         every = self.config.image_every
         if tick.frame.rgb is not None and every and tick.step % every == 0:
             log_image(self._rec, tick, self.context.camera, self.config.jpeg_quality)
