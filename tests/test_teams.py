@@ -304,7 +304,7 @@ def test_the_team_evader_hides_from_the_nearest_pursuer_of_each_candidate(solo):
         reference.count,
     )
     # A second pursuer standing on the 1v1 escape point moves the evader's choice away.
-    goal = tuple(evader.search.centres[alone.cell])
+    goal = tuple(evader.search.centres(alone.cell))
     guarded = evader.team_escape(me, (a, Pose(goal[0], goal[1], math.pi)))
     assert guarded.cell != alone.cell
 

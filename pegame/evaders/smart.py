@@ -201,7 +201,7 @@ class SmartEvader(Evader):
         if cells.size == 0:
             return Escape(-1, math.inf, 0, cells)
         if self.config.distance == "euclidean":
-            x, y = search.centres[cells].T
+            x, y = search.centres(cells).T
             effort = np.sqrt((x - me.x) ** 2 + (y - me.y) ** 2)
             dist = np.min([np.sqrt((x - p.x) ** 2 + (y - p.y) ** 2) for p in pursuers], axis=0)
         else:

@@ -199,7 +199,7 @@ class CooperativePursuer(SmartPursuer):
                 me = Pose(*team.detections[tracker][j].position)
                 found = self.escape.escape(me, team.pursuers[tracker], team.union)
                 if found.count:
-                    goal = tuple(float(v) for v in self.escape.centres[found.cell])
+                    goal = tuple(float(v) for v in self.escape.centres(found.cell))
                     tasks.append(Task(goal, self.config.cover_value, j, "cover"))
                 continue
             tasks.extend(self._search_tasks(belief, j, free))
