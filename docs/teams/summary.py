@@ -2,13 +2,24 @@
 ``python docs/teams/summary.py docs/teams/report`` prints one Markdown row per
 (map, evaders, pursuers): each team's mean tracking rate with its 95% bootstrap CI and n,
 and the paired difference cooperative - independent with its CI and Holm-corrected
-Wilcoxon p (pegame.report's compare_pairing.csv)."""
+Wilcoxon p (pegame.report's compare_pairing.csv).
+
+``python docs/teams/summary.py docs/teams/report --pooled outputs/teams`` also prints the
+pooled comparison over the cells with at least two pursuers, from the sweep's own
+``results.jsonl`` files (games paired by map, team sizes and seed): the mean difference
+cooperative - independent with its 95% percentile-bootstrap CI (10,000 resamples of the
+pairs, seed 0) and the two-sided Wilcoxon signed-rank p, over all those cells and per
+number of evaders."""
 
 from __future__ import annotations
 
 import csv
+import json
 import sys
 from pathlib import Path
+
+import numpy as np
+from scipy.stats import wilcoxon
 
 MAPS = ("hall", "enclosed", "brick", "office")
 
@@ -52,5 +63,35 @@ def main(report: Path) -> None:
         print("| " + " | ".join(row) + " |")
 
 
+def pooled(sweep: Path) -> None:
+    """Print the pooled paired comparison (module docstring) of the games under ``sweep``."""
+    rates: dict[tuple, float] = {}
+    for path in sweep.rglob("results.jsonl"):
+        for line in path.read_text().splitlines():
+            game = json.loads(line)
+            if game.get("kind") != "game":
+                continue
+            team = game["config"]["team"]
+            key = (game["map"], team["evaders"], team["pursuers"], game["seed"])
+            rates[(*key, game["pairing"])] = game["tracking_rate"]
+    pairs = [
+        (key[1], rates[(*key, "cooperative-S")] - rate)
+        for (*key, pairing), rate in rates.items()
+        if pairing == "S-S" and key[2] >= 2 and (*key, "cooperative-S") in rates
+    ]
+    rng = np.random.default_rng(0)
+    for label, evaders in (("all", (1, 2)), ("1 evader", (1,)), ("2 evaders", (2,))):
+        d = np.array([diff for m, diff in pairs if m in evaders])
+        means = d[rng.integers(0, d.size, (10_000, d.size))].mean(axis=1)
+        low, high = np.percentile(means, [2.5, 97.5])
+        p = wilcoxon(d).pvalue
+        print(
+            f"pooled {label}: {d.size} pairs, {100 * d.mean():+.1f} pp "
+            f"[{100 * low:+.1f}, {100 * high:+.1f}], Wilcoxon p = {p:.2g}"
+        )
+
+
 if __name__ == "__main__":
     main(Path(sys.argv[1]))
+    if "--pooled" in sys.argv:
+        pooled(Path(sys.argv[sys.argv.index("--pooled") + 1]))
