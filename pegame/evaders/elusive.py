@@ -67,8 +67,9 @@ class ElusiveEvader(Evader):
     @dataclass
     class Config(Evader.Config):
         horizon: float = 3.0  # m; candidate cells lie within this path length of the evader
-        pursuer_weight: float = 1.0  # s of the evader's walk worth one s of the pursuer's
-        time_cap: float = 20.0  # s; the pursuer's time to a cell counts up to this
+        flee_weight: float = 1.0  # s of walking worth one s of the pursuer's, when faster than it
+        hide_weight: float = 0.25  # the same when the pursuer is at least as fast
+        horizon_p: float = 10.0  # m; the pursuer's path length to a cell counts up to this
         exposed_penalty: float = 4.0  # s; cost of a cell the pursuer sees by turning round
         hide_margin: float = 0.3  # m; a hidden cell lies this far outside the seen cells
         sight_angle_step: float = 0.005  # rad between rays of the full-turn region
@@ -76,13 +77,12 @@ class ElusiveEvader(Evader):
         def __post_init__(self) -> None:
             super().__post_init__()
             require(self.horizon > 0, "evader.horizon", "a positive distance in m", self.horizon)
-            require(self.time_cap > 0, "evader.time_cap", "a positive time in s", self.time_cap)
             require(
-                self.pursuer_weight >= 0,
-                "evader.pursuer_weight",
-                "a weight >= 0 (s per s)",
-                self.pursuer_weight,
+                self.horizon_p > 0, "evader.horizon_p", "a positive distance in m", self.horizon_p
             )
+            for key in ("flee_weight", "hide_weight"):
+                value = getattr(self, key)
+                require(value >= 0, f"evader.{key}", "a weight >= 0 (s per s)", value)
             require(
                 self.exposed_penalty >= 0,
                 "evader.exposed_penalty",
@@ -109,9 +109,6 @@ class ElusiveEvader(Evader):
         self._all_round = dataclasses.replace(
             context.camera, fov=2 * math.pi, angle_step=config.sight_angle_step
         )
-        rows, cols = np.indices(grid.data.shape)
-        #: cell centres (m, map frame) by flat row-major index: x (H * W,), y (H * W,)
-        self._centres = tuple(v.ravel() for v in grid.cell_to_world(rows, cols))
         self.reset(Pose(0.0, 0.0))
 
     def reset(self, pose: Pose) -> None:
@@ -149,14 +146,15 @@ class ElusiveEvader(Evader):
         else:
             seen, bounds = region.mask, region.bounds
         d_e = self.planner.distance_field((me.x, me.y)).ravel()
-        x, y = self._centres
-        d_p = np.hypot(x - pursuer.x, y - pursuer.y)
+        d_p = self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()
+        faster = context.evader.v_max > context.pursuer.v_max
+        weight = config.flee_weight if faster else config.hide_weight
         reachable = np.isfinite(d_e)
         in_view = self._grown(seen, bounds).ravel()
         exposed = self._grown(*whole_region(grid, pursuer, self._all_round)).ravel()
         score = (
             np.where(reachable, d_e, 0.0) / context.evader.v_max
-            - config.pursuer_weight * np.minimum(d_p / context.pursuer.v_max, config.time_cap)
+            - weight * np.minimum(d_p, config.horizon_p) / context.pursuer.v_max
             + config.exposed_penalty * exposed
         )
         for candidates in (
