@@ -4,29 +4,31 @@ pursuer's pose, its camera and the map).
 
 The paper's smart evader (Algorithm 2) runs to the out-of-view cell of least
 effort / distance and parks there. Against a pursuer that turns at 1.8 rad/s that cell,
-just outside the camera's 60 degree wedge, is found again by a turn, and a parked evader
-is where the estimator's particles are. This evader scores every cell c it can reach
-within ``horizon`` m (geodesic) by
+just outside the camera's 60 degree wedge, is found again by a turn. This evader scores
+every cell c it can reach within ``horizon`` m (geodesic) by a time (s):
 
-    cost(c) = effort_weight * d_e(c) - min(d_p(c), horizon_p) + exposed_penalty * [c in O]
+    cost(c) = d_e(c) / v_e - weight * min(d_p(c), horizon_p) / v_p + exposed_penalty * [c in O]
 
-(all in m): d_e the evader's and d_p the pursuer's shortest 8-connected grid paths
-(:meth:`pegame.navigation.Planner.distance_field`, each over the cells traversable for
-its radius), and O the cells the pursuer sees from its position when it turns all the
-way round: Algorithm 1 with occlusion for the pursuer's camera with a full-turn field of
-view (:func:`pegame.visibility.visibility_region`), grown by ``hide_margin`` so the whole
-body is hidden. Cells in the camera's current region V (grown the same way) are not
-candidates. So the evader prefers cells the pursuer cannot see without moving (behind an
-obstacle or beyond its range) and, among those, the ones the pursuer needs longest to
-reach, paying ``effort_weight`` m of that distance per metre it walks: with a weight below
-1 the goal keeps moving away from the pursuer, the "moving on rather than parking"
-direction. The pursuer's distance is capped at ``horizon_p`` m so cells it cannot reach at
-all do not outweigh every other consideration. It is the escape-time idea of
-visibility-based pursuit-evasion (the target maximises the pursuer's time to see it
-again: Gonzalez-Banos, Lee and Latombe, "Real-time combinatorial tracking of a target
-moving unpredictably among obstacles", ICRA 2002; Bandyopadhyay et al., "Stealth
-tracking of an unpredictable target among obstacles", WAFR 2004, for the target's side),
-with the pursuer's geodesic distance in place of its reachable set.
+with d_e the evader's and d_p the pursuer's shortest 8-connected grid paths (m,
+:meth:`pegame.navigation.Planner.distance_field`, each over the cells traversable for its
+radius), v_e and v_p their top speeds (m/s), and O the cells the pursuer sees from its
+position when it turns all the way round: Algorithm 1 with occlusion for the pursuer's
+camera with a full-turn field of view (:func:`pegame.visibility.visibility_region`),
+grown by ``hide_margin`` so the whole body is hidden. Cells in the camera's current
+region V (grown the same way) are not candidates. So the evader prefers cells the
+pursuer cannot see without moving (behind an obstacle or beyond its range) and, among
+those, the ones it reaches soon and the pursuer late. Walking straight away from the
+pursuer lowers the cost when v_p / v_e < weight, so the weight sets whether the evader
+flees or hides: ``flee_weight`` when it is faster than the pursuer (it can leave the
+camera's range, and keeps moving on rather than parking), ``hide_weight`` otherwise (it
+takes the nearest cell out of the pursuer's line of sight, and stays there until that
+cell is seen). The pursuer's distance counts up to ``horizon_p`` m so that cells it
+cannot reach at all do not outweigh everything else. It is the escape-time idea of
+visibility-based tracking seen from the target's side (the target maximises the time
+the observer needs to see it again: Gonzalez-Banos, Lee and Latombe, "Real-time
+combinatorial tracking of a target moving unpredictably among obstacles", ICRA 2002;
+Bandyopadhyay et al., "Stealth tracking of an unpredictable target among obstacles",
+WAFR 2004), with the pursuer's geodesic distance in place of its reachable set.
 
 When no cell within the horizon lies outside V, every reachable cell outside V is a
 candidate; when V covers every reachable cell, every reachable cell is (the evader then
@@ -117,7 +119,7 @@ class ElusiveEvader(Evader):
 
     def decide(self, observation: EvaderObservation) -> Plan:
         """Choose the goal cell for this tick (module docstring); replan when it moved by
-        more than a cell. The plan's info holds "cost", the goal's cost (m)."""
+        more than a cell. The plan's info holds "cost", the goal's cost (s)."""
         me, pursuer = observation.pose, observation.pursuer
         cost = self.costs(me, pursuer, observation.pursuer_region)
         if not np.isfinite(cost).any():
