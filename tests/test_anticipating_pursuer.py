@@ -88,8 +88,12 @@ def test_evader_speed_caps_the_velocity_estimate():
 
 def particles_at(xy, n=200, spread=0.05, seed=0) -> Belief:
     rng = np.random.default_rng(seed)
-    points = np.column_stack([rng.normal(xy[0], spread, n), rng.normal(xy[1], spread, n), np.zeros(n)])
-    return Belief(mean=tuple(points[:, :2].mean(axis=0)), particles=points, weights=np.full(n, 1 / n))
+    points = np.column_stack(
+        [rng.normal(xy[0], spread, n), rng.normal(xy[1], spread, n), np.zeros(n)]
+    )
+    return Belief(
+        mean=tuple(points[:, :2].mean(axis=0)), particles=points, weights=np.full(n, 1 / n)
+    )
 
 
 def test_lost_evader_in_line_of_sight_beside_the_view_is_looked_at():
@@ -113,19 +117,17 @@ def test_belief_behind_a_wall_is_not_looked_at():
     context = dataclasses.replace(open_context(), grid=OccupancyGrid(data, 0.1))
     pursuer = make(AnticipatingPursuer, context)
     pose = Pose(4.0, 4.0, 0.0)
-    assert pursuer.best_look(observation(1.0, pose, None, particles_at((4.0, 6.5)), context))[1] == 0
+    assert (
+        pursuer.best_look(observation(1.0, pose, None, particles_at((4.0, 6.5)), context))[1] == 0
+    )
     pursuer.decide(observation(1.0, pose, None, particles_at((4.0, 6.5)), context))
     assert pursuer.mode != LOOK
 
 
 def best_wedge_reference(bearings, weights, fov):
-    """Brute force: every bearing as the window's start, weights summed by angle tests."""
-    best, mass = 0.0, -1.0
-    for start in np.mod(bearings, 2 * math.pi):
-        inside = np.mod(bearings - start, 2 * math.pi) <= fov + 1e-12
-        if weights[inside].sum() > mass + 1e-12:
-            mass = weights[inside].sum()
-    return mass
+    """Brute force: the most weight in a window starting at a bearing, by angle tests."""
+    starts = np.mod(bearings, 2 * math.pi)
+    return max(weights[np.mod(bearings - s, 2 * math.pi) <= fov + 1e-12].sum() for s in starts)
 
 
 @pytest.mark.parametrize("seed", range(20))

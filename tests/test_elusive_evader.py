@@ -41,7 +41,9 @@ def pillar_context(pursuer_speed: float = 0.5) -> Context:
 
 
 def make(context: Context, **params) -> ElusiveEvader:
-    evader = ElusiveEvader(make_config("evader", ElusiveEvader, params), context, np.random.default_rng(0))
+    evader = ElusiveEvader(
+        make_config("evader", ElusiveEvader, params), context, np.random.default_rng(0)
+    )
     evader.reset(Pose(0.0, 0.0))
     return evader
 

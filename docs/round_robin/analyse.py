@@ -48,18 +48,54 @@ RATIOS = (0.5, 1.0, 2.0)
 #: "no lower" goals where x is not significantly lower than y (Holm-corrected p >= alpha
 #: of the one-sided test x < y).
 GOALS = [
-    ("pursuer beats smart vs smart evader", "paper_conditions", ("anticipating", "smart"),
-     ("smart", "smart"), "greater", "higher"),
-    ("pursuer no lower vs smart evader", "default", ("anticipating", "smart"),
-     ("smart", "smart"), "less", "no lower"),
-    ("pursuer no worse vs random evader", "paper_conditions", ("anticipating", "random"),
-     ("smart", "random"), "less", "no lower"),
-    ("pursuer no worse vs random evader", "default", ("anticipating", "random"),
-     ("smart", "random"), "less", "no lower"),
-    ("evader beats smart vs smart pursuer", "paper_conditions", ("smart", "elusive"),
-     ("smart", "smart"), "less", "lower"),
-    ("evader beats smart vs smart pursuer", "default", ("smart", "elusive"),
-     ("smart", "smart"), "less", "lower"),
+    (
+        "pursuer beats smart vs smart evader",
+        "paper_conditions",
+        ("anticipating", "smart"),
+        ("smart", "smart"),
+        "greater",
+        "higher",
+    ),
+    (
+        "pursuer no lower vs smart evader",
+        "default",
+        ("anticipating", "smart"),
+        ("smart", "smart"),
+        "less",
+        "no lower",
+    ),
+    (
+        "pursuer no worse vs random evader",
+        "paper_conditions",
+        ("anticipating", "random"),
+        ("smart", "random"),
+        "less",
+        "no lower",
+    ),
+    (
+        "pursuer no worse vs random evader",
+        "default",
+        ("anticipating", "random"),
+        ("smart", "random"),
+        "less",
+        "no lower",
+    ),
+    (
+        "evader beats smart vs smart pursuer",
+        "paper_conditions",
+        ("smart", "elusive"),
+        ("smart", "smart"),
+        "less",
+        "lower",
+    ),
+    (
+        "evader beats smart vs smart pursuer",
+        "default",
+        ("smart", "elusive"),
+        ("smart", "smart"),
+        "less",
+        "lower",
+    ),
 ]
 
 
@@ -76,8 +112,13 @@ def load(out: Path) -> tuple[dict, list[dict]]:
             for record in sweep.records:
                 records.append({**record, "conditions": conditions})
                 if record.get("kind") == "game":
-                    key = (conditions, record["pursuer"], record["evader"], record["map"],
-                           float(record["speed_ratio"]))
+                    key = (
+                        conditions,
+                        record["pursuer"],
+                        record["evader"],
+                        record["map"],
+                        float(record["speed_ratio"]),
+                    )
                     cells[key].append(record)
     return cells, records
 
@@ -87,8 +128,19 @@ def write_table(cells: dict, path: Path) -> dict:
     means = {}
     with path.open("w", newline="") as f:
         out = csv.writer(f)
-        out.writerow(["conditions", "pursuer", "evader", "map", "speed_ratio", "n", "mean",
-                      "ci_low", "ci_high"])
+        out.writerow(
+            [
+                "conditions",
+                "pursuer",
+                "evader",
+                "map",
+                "speed_ratio",
+                "n",
+                "mean",
+                "ci_low",
+                "ci_high",
+            ]
+        )
         for conditions in CONDITIONS:
             for pursuer in PURSUERS:
                 for evader in EVADERS:
@@ -100,9 +152,19 @@ def write_table(cells: dict, path: Path) -> dict:
                                 continue
                             d = describe([float(g["tracking_rate"]) for g in games])
                             means[key] = d["mean"]
-                            out.writerow([conditions, pursuer, evader, name, f"{ratio:g}", d["n"],
-                                          f"{d['mean']:.6f}", f"{d['ci_low']:.6f}",
-                                          f"{d['ci_high']:.6f}"])
+                            out.writerow(
+                                [
+                                    conditions,
+                                    pursuer,
+                                    evader,
+                                    name,
+                                    f"{ratio:g}",
+                                    d["n"],
+                                    f"{d['mean']:.6f}",
+                                    f"{d['ci_low']:.6f}",
+                                    f"{d['ci_high']:.6f}",
+                                ]
+                            )
     return means
 
 
@@ -122,8 +184,15 @@ def heat_maps(means: dict, out: Path) -> None:
                     for b in range(len(EVADERS)):
                         text = "–" if math.isnan(grid[a, b]) else f"{100 * grid[a, b]:.0f}"
                         light = not math.isnan(grid[a, b]) and grid[a, b] < 0.6
-                        ax.text(b, a, text, ha="center", va="center",
-                                color="white" if light else "black", fontsize=11)
+                        ax.text(
+                            b,
+                            a,
+                            text,
+                            ha="center",
+                            va="center",
+                            color="white" if light else "black",
+                            fontsize=11,
+                        )
                 ax.set_xticks(range(len(EVADERS)), EVADERS)
                 ax.set_yticks(range(len(PURSUERS)), PURSUERS)
                 ax.set_title(f"{conditions}, v_p/v_e = {ratio:g}", fontsize=10)
@@ -147,9 +216,19 @@ def goal_tests(cells: dict) -> list[dict]:
                 a = cells.get((conditions, *x, name, ratio), [])
                 b = cells.get((conditions, *y, name, ratio), [])
                 test = paired_test(by_seed(a), by_seed(b), alternative)
-                family.append({"goal": goal, "conditions": conditions,
-                               "x": "-".join(x), "y": "-".join(y), "alternative": alternative,
-                               "meaning": meaning, "map": name, "speed_ratio": ratio, **test})
+                family.append(
+                    {
+                        "goal": goal,
+                        "conditions": conditions,
+                        "x": "-".join(x),
+                        "y": "-".join(y),
+                        "alternative": alternative,
+                        "meaning": meaning,
+                        "map": name,
+                        "speed_ratio": ratio,
+                        **test,
+                    }
+                )
         tested = [r for r in family if r["p"] is not None]
         for row, p in zip(tested, holm([r["p"] for r in tested])):
             row["p_holm"] = p
@@ -163,21 +242,43 @@ def goal_tests(cells: dict) -> list[dict]:
 
 
 def write_goals(rows: list[dict], out: Path) -> None:
-    keys = ["goal", "conditions", "x", "y", "alternative", "map", "speed_ratio", "n_pairs",
-            "mean_x", "mean_y", "mean_difference", "ci_low", "ci_high", "zero_differences",
-            "W", "p", "p_holm", "rank_biserial", "met"]
+    keys = [
+        "goal",
+        "conditions",
+        "x",
+        "y",
+        "alternative",
+        "map",
+        "speed_ratio",
+        "n_pairs",
+        "mean_x",
+        "mean_y",
+        "mean_difference",
+        "ci_low",
+        "ci_high",
+        "zero_differences",
+        "W",
+        "p",
+        "p_holm",
+        "rank_biserial",
+        "met",
+    ]
     with (out / "goals.csv").open("w", newline="") as f:
         writer = csv.DictWriter(f, keys, extrasaction="ignore")
         writer.writeheader()
         writer.writerows(rows)
-    lines = ["# The goals of issue 18, cell by cell", "",
-             "Paired on common seeds (same seed, same spawn poses): one-sided Wilcoxon "
-             "signed-rank test with Pratt's zeros of x - y (scipy.stats.wilcoxon), "
-             "Holm-Bonferroni corrected across the nine cells of each goal and conditions, "
-             f"alpha = {ALPHA}; mean paired difference in percentage points with its "
-             "percentile-bootstrap CI over seeds. 'higher'/'lower' goals are met where the "
-             "corrected p is below alpha; 'no lower' goals where x is not significantly "
-             "lower than y (corrected p of the one-sided test x < y at least alpha).", ""]
+    lines = [
+        "# The goals of issue 18, cell by cell",
+        "",
+        "Paired on common seeds (same seed, same spawn poses): one-sided Wilcoxon "
+        "signed-rank test with Pratt's zeros of x - y (scipy.stats.wilcoxon), "
+        "Holm-Bonferroni corrected across the nine cells of each goal and conditions, "
+        f"alpha = {ALPHA}; mean paired difference in percentage points with its "
+        "percentile-bootstrap CI over seeds. 'higher'/'lower' goals are met where the "
+        "corrected p is below alpha; 'no lower' goals where x is not significantly "
+        "lower than y (corrected p of the one-sided test x < y at least alpha).",
+        "",
+    ]
     seen = []
     for row in rows:
         head = (row["goal"], row["conditions"])
@@ -185,21 +286,28 @@ def write_goals(rows: list[dict], out: Path) -> None:
             seen.append(head)
             family = [r for r in rows if (r["goal"], r["conditions"]) == head]
             met = sum(bool(r["met"]) for r in family)
-            lines += ["", f"## {row['goal']} ({row['conditions']}): {row['x']} against "
-                      f"{row['y']}, goal '{row['meaning']}': met in {met} of {len(family)} cells",
-                      "", "| map | v_p/v_e | pairs | x mean | y mean | x - y [CI] | W | p | "
-                      "p (Holm) | met |", "|---|---|---|---|---|---|---|---|---|---|"]
+            lines += [
+                "",
+                f"## {row['goal']} ({row['conditions']}): {row['x']} against "
+                f"{row['y']}, goal '{row['meaning']}': met in {met} of {len(family)} cells",
+                "",
+                "| map | v_p/v_e | pairs | x mean | y mean | x - y [CI] | W | p | p (Holm) | met |",
+                "|---|---|---|---|---|---|---|---|---|---|",
+            ]
             for r in family:
                 if r["p"] is None:
-                    lines.append(f"| {r['map']} | {r['speed_ratio']:g} | {r['n_pairs']} | – | – "
-                                 "| – | – | – | – | not tested |")
+                    lines.append(
+                        f"| {r['map']} | {r['speed_ratio']:g} | {r['n_pairs']} | – | – "
+                        "| – | – | – | – | not tested |"
+                    )
                     continue
                 lines.append(
                     f"| {r['map']} | {r['speed_ratio']:g} | {r['n_pairs']} | "
                     f"{100 * r['mean_x']:.1f}% | {100 * r['mean_y']:.1f}% | "
                     f"{100 * r['mean_difference']:+.1f} pp [{100 * r['ci_low']:+.1f}, "
                     f"{100 * r['ci_high']:+.1f}] | {r['W']:g} | {r['p']:.3g} | "
-                    f"{r['p_holm']:.3g} | {'yes' if r['met'] else 'no'} |")
+                    f"{r['p_holm']:.3g} | {'yes' if r['met'] else 'no'} |"
+                )
     (out / "goals.md").write_text("\n".join(lines) + "\n")
 
 
@@ -211,12 +319,17 @@ def write_provenance(records: list[dict], cells: dict, out: Path) -> None:
     for g in games:
         p = g.get("provenance", {})
         commits[(p.get("commit"), p.get("dirty"))] += 1
-        versions.add(f"pegame {p.get('pegame')}, Python {p.get('python')}, numpy "
-                     f"{p.get('numpy')}, numba {p.get('numba')}")
+        versions.add(
+            f"pegame {p.get('pegame')}, Python {p.get('python')}, numpy "
+            f"{p.get('numpy')}, numba {p.get('numba')}"
+        )
     short = [k for k, games_ in cells.items() if len(games_) < 40]
-    lines = ["# Provenance of the round-robin (read from the games' result lines)", "",
-             f"- games: {len(games)}, failed: {len(failed)}, cells: {len(cells)}, cells "
-             f"with fewer than 40 games: {len(short)}"]
+    lines = [
+        "# Provenance of the round-robin (read from the games' result lines)",
+        "",
+        f"- games: {len(games)}, failed: {len(failed)}, cells: {len(cells)}, cells "
+        f"with fewer than 40 games: {len(short)}",
+    ]
     for (commit, dirty), n in sorted(commits.items(), key=str):
         lines.append(f"- commit {commit} ({'dirty' if dirty else 'clean'}): {n} games")
     lines += [f"- {v}" for v in sorted(versions)]

@@ -181,7 +181,9 @@ class ElusiveEvader(Evader):
         r0, c0 = max(r0 - reach, 0), max(c0 - reach, 0)
         r1, c1 = min(r1 + reach, height), min(c1 + reach, width)
         grown = np.zeros_like(mask)
-        grown[r0:r1, c0:c1] = maximum_filter(mask[r0:r1, c0:c1], size=2 * reach + 1, mode="constant")
+        grown[r0:r1, c0:c1] = maximum_filter(
+            mask[r0:r1, c0:c1], size=2 * reach + 1, mode="constant"
+        )
         return grown
 
     def _needs_replan(self, cell: tuple[int, int]) -> bool:
