@@ -142,3 +142,16 @@ def test_best_wedge_holds_the_most_weight(seed):
     assert mass == pytest.approx(best_wedge_reference(bearings, weights, CAMERA.fov))
     inside = np.abs(np.angle(np.exp(1j * (bearings - centre)))) <= 0.5 * CAMERA.fov + 1e-9
     assert weights[inside].sum() == pytest.approx(mass)
+
+
+def test_an_evader_that_stops_is_predicted_where_it_stands():
+    """Fresh detections of an evader that stopped (new Detection objects, same position):
+    the velocity estimate drops to zero, so the prediction does not run off with the speed
+    it had before (regression: identical positions were taken for a held result)."""
+    context = open_context()
+    pursuer = make(AnticipatingPursuer, context, lead_time=0.5)
+    pose = Pose(2.0, 4.0, 0.0)
+    pursuer.control(observation(0.0, pose, detection_at(pose, (4.0, 4.0)), context=context))
+    for k in range(1, 30):
+        pursuer.control(observation(0.1 * k, pose, detection_at(pose, (4.4, 4.0)), context=context))
+    assert pursuer._predicted(2.9) == pytest.approx((4.4, 4.0))

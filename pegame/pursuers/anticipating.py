@@ -8,8 +8,8 @@ detector delivers a result once per node period and holds it (the paper's 1 Hz n
 ``+experiment=paper_conditions``): the held offset then keeps the robot turning for the
 whole period after it already faces the evader, and it overshoots. This pursuer servoes
 in the map frame instead: it keeps the detection's map position (``detection.position``,
-m) and a velocity estimate from the last two distinct detections (m/s, at most the
-evader's ``v_max``), predicts the evader ``lead_time`` s past now from the time the
+m) and a velocity estimate from the last two delivered detections (m/s, at most the
+evader's ``v_max``; a held result is the same Detection object and is not counted again), predicts the evader ``lead_time`` s past now from the time the
 detection arrived, and at every control tick turns at w = k_heading * (bearing of the
 prediction from its own current pose) (rad/s) and drives at v = k_v * (range - standoff)
 (m/s), slowed by cos(bearing) so it turns before it closes in. It is the constant-velocity
@@ -108,9 +108,10 @@ class AnticipatingPursuer(SmartPursuer):
 
     def reset(self, pose: Pose) -> None:
         super().reset(pose)
-        self._seen: tuple[float, float] | None = None  # last detected position (m)
+        self._detection = None  # the last Detection delivered
+        self._seen: tuple[float, float] | None = None  # its position (m)
         self._seen_at = 0.0  # s, when that detection arrived
-        self._velocity = (0.0, 0.0)  # m/s, from the last two distinct detections
+        self._velocity = (0.0, 0.0)  # m/s, from the last two delivered detections
         self._look_heading = 0.0
 
     # -- the strategy
@@ -148,10 +149,13 @@ class AnticipatingPursuer(SmartPursuer):
     # -- tracking
 
     def _note(self, observation: PursuerObservation) -> None:
-        """Keep the detection's position; a new position updates the velocity estimate."""
-        position = observation.detection.position
-        if position == self._seen:
-            return  # the detector holds its last result
+        """Keep a newly delivered detection's position and update the velocity estimate
+        from the previous one. A detector that holds its last result (a rate below the
+        control rate) delivers the same Detection object again; that one is not new."""
+        detection = observation.detection
+        if detection is self._detection:
+            return
+        position = (float(detection.position[0]), float(detection.position[1]))
         if self._seen is not None:
             dt = observation.time - self._seen_at
             if dt > 0:
@@ -159,7 +163,7 @@ class AnticipatingPursuer(SmartPursuer):
                 speed, v_max = math.hypot(vx, vy), self.context.evader.v_max
                 scale = min(1.0, v_max / speed) if speed > 0 else 0.0
                 self._velocity = (vx * scale, vy * scale)
-        self._seen, self._seen_at = (float(position[0]), float(position[1])), observation.time
+        self._detection, self._seen, self._seen_at = detection, position, observation.time
 
     def _predicted(self, time: float) -> tuple[float, float]:
         """The evader's position (m) predicted ``lead_time`` s after ``time`` (s)."""
