@@ -15,6 +15,7 @@ Writes into --out:
   (map x speed ratio), on the seeds both sides played (same seed, same spawn poses): the
   one-sided Wilcoxon signed-rank test with Pratt's zeros (:mod:`pegame.report.paired`),
   Holm-Bonferroni corrected across the nine cells of each goal and conditions;
+- ``summary.md``: the mean tracking rates as Markdown tables;
 - ``provenance.md``: the commits, dirty flags, package versions and game counts read
   from the games' own result lines.
 """
@@ -30,12 +31,12 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from pegame.report.load import load_sweep  # noqa: E402
-from pegame.report.paired import by_seed, paired_test  # noqa: E402
-from pegame.report.statistics import ALPHA, describe, holm  # noqa: E402
+from pegame.report.load import load_sweep
+from pegame.report.paired import by_seed, paired_test
+from pegame.report.statistics import ALPHA, describe, holm
 
 CONDITIONS = ("default", "paper_conditions")
 PURSUERS = ("random", "smart", "anticipating", "policy")
@@ -206,6 +207,36 @@ def heat_maps(means: dict, out: Path) -> None:
         plt.close(fig)
 
 
+def write_summary(means: dict, path: Path) -> None:
+    """summary.md: the mean tracking rates (%) as one table per conditions and speed ratio,
+    pursuers x (map, evader); '–' where a cell was not played."""
+    lines = [
+        "# Round-robin: mean tracking rate (%)",
+        "",
+        "Rows: pursuers; columns: map / evader; n = 40 games per cell unless "
+        "provenance.md lists it. CIs are in table.csv.",
+    ]
+    header = [f"{name} / {evader}" for name in MAPS for evader in EVADERS]
+    for conditions in CONDITIONS:
+        for ratio in RATIOS:
+            lines += [
+                "",
+                f"## {conditions}, v_p/v_e = {ratio:g}",
+                "",
+                "| pursuer | " + " | ".join(header) + " |",
+                "|---|" + "---|" * len(header),
+            ]
+            for pursuer in PURSUERS:
+                values = [
+                    means.get((conditions, pursuer, evader, name, ratio))
+                    for name in MAPS
+                    for evader in EVADERS
+                ]
+                text = ["–" if v is None else f"{100 * v:.1f}" for v in values]
+                lines.append(f"| {pursuer} | " + " | ".join(text) + " |")
+    path.write_text("\n".join(lines) + "\n")
+
+
 def goal_tests(cells: dict) -> list[dict]:
     """One row per goal, conditions and cell, Holm-corrected per goal and conditions."""
     rows = []
@@ -348,6 +379,7 @@ def main() -> None:
     cells, records = load(args.sweeps)
     means = write_table(cells, args.out / "table.csv")
     heat_maps(means, args.out)
+    write_summary(means, args.out / "summary.md")
     write_goals(goal_tests(cells), args.out)
     write_provenance(records, cells, args.out)
 
