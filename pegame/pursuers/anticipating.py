@@ -9,8 +9,9 @@ detector delivers a result once per node period and holds it (the paper's 1 Hz n
 whole period after it already faces the evader, and it overshoots. This pursuer servoes
 in the map frame instead: it keeps the detection's map position (``detection.position``,
 m) and a velocity estimate from the last two delivered detections (m/s, at most the
-evader's ``v_max``; a held result is the same Detection object and is not counted again), predicts the evader ``lead_time`` s past now from the time the
-detection arrived, and at every control tick turns at w = k_heading * (bearing of the
+evader's ``v_max``; a held result is the same Detection object and is not counted
+again), predicts the evader ``lead_time`` s past now from the time the detection
+arrived, and at every control tick turns at w = k_heading * (bearing of the
 prediction from its own current pose) (rad/s) and drives at v = k_v * (range - standoff)
 (m/s), slowed by cos(bearing) so it turns before it closes in. It is the constant-velocity
 lead of predictive visual servoing (Chaumette & Hutchinson, "Visual servo control, Part
