@@ -19,7 +19,8 @@ II", IEEE RAM 2007, Sec. on target motion compensation) in place of a pure image
 Under fresh detections at the control rate the two servos differ little (the paper's
 k_w = 4 on the normalised offset is about 3.5 rad/s per rad of bearing near the axis);
 the lead and the held detections make the difference. The collision look-ahead and the
-detour are the smart pursuer's.
+detour are the smart pursuer's, as are its other settings (``k_w``, the image servo's gain,
+stays in the config but this servo does not use it).
 
 Searching (nothing detected): the smart pursuer drives to the belief's weighted mean.
 When the belief is split (the evader went round one of two sides of an obstacle) the mean
