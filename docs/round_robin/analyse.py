@@ -202,7 +202,7 @@ def heat_maps(means: dict, out: Path) -> None:
                 if i == 1:
                     ax.set_xlabel("evader")
         fig.colorbar(image, ax=axes, shrink=0.6, label="mean tracking rate (%)")
-        fig.suptitle(f"Round-robin on {name}: mean tracking rate (%), n = 40 per cell")
+        fig.suptitle(f"Round-robin on {name}: mean tracking rate (%); n per cell in table.csv")
         fig.savefig(out / f"heatmap_{name}.png", dpi=110)
         plt.close(fig)
 
