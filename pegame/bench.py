@@ -145,8 +145,11 @@ def team_scaling(games: int, out_dir: str, t_max: float = 90.0) -> dict[str, flo
     }
 
 
-def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]:
-    """ms per decision of the smart pursuer (estimator update + plan) and smart evader."""
+def bench_decisions(
+    grid: OccupancyGrid, repeat: int, pursuer_name: str = "smart", evader_name: str = "smart"
+) -> dict[str, float | None]:
+    """ms per decision of a pursuer (estimator update + plan, the evader not detected) and
+    an evader, by default the smart ones."""
     out: dict[str, float | None] = {
         "pursuer_decision_ms": None,
         "evader_decision_ms": None,
@@ -170,8 +173,8 @@ def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]
             return pf.update(0.1, p, None, mask)
 
         out["pf_step_ms"] = median_ms(pf_step, repeat)
-        if "smart" in registry.available("pursuer"):
-            pcls = registry.load("pursuer", "smart")
+        if pursuer_name in registry.available("pursuer"):
+            pcls = registry.load("pursuer", pursuer_name)
             pursuer = pcls(
                 registry.make_config("pursuer", pcls, {}), context, np.random.default_rng(1)
             )
@@ -184,8 +187,8 @@ def bench_decisions(grid: OccupancyGrid, repeat: int) -> dict[str, float | None]
                 return pursuer.decide(PursuerObservation(0.0, p, None, belief, mask))
 
             out["pursuer_decision_ms"] = median_ms(pursuer_decision, repeat)
-    if "smart" in registry.available("evader"):
-        ecls = registry.load("evader", "smart")
+    if evader_name in registry.available("evader"):
+        ecls = registry.load("evader", evader_name)
         evader = ecls(registry.make_config("evader", ecls, {}), context, np.random.default_rng(2))
         evader.reset(pairs[0][1])
         it3 = iter(pairs * 2)
@@ -288,6 +291,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             "plan_ms": plan_ms,
             **bench_decisions(grid, max(10, repeat // 4)),
         }
+        stronger = bench_decisions(grid, max(10, repeat // 4), "anticipating", "elusive")
+        per_map[name]["anticipating_decision_ms"] = stronger["pursuer_decision_ms"]
+        per_map[name]["elusive_decision_ms"] = stronger["evader_decision_ms"]
     report["maps"] = per_map
     report["sim_steps_per_s"] = bench_sim_steps(grids["enclosed"], 2000 if args.quick else 20000)
 
@@ -345,6 +351,11 @@ def format_report(report: dict[str, Any]) -> str:
             f"{fmt(row.get('pursuer_decision_ms')):>10}{fmt(row.get('evader_decision_ms')):>10}"
             f"{fmt(row.get('ss_games_per_s')):>13}"
         )
+    stronger = ", ".join(
+        f"{name} {fmt(row.get('anticipating_decision_ms'))} / {fmt(row.get('elusive_decision_ms'))}"
+        for name, row in report["maps"].items()
+    )
+    lines.append(f"anticipating pursuer / elusive evader decision ms: {stronger or '-'}")
     lines.append(f"grid sim: {report['sim_steps_per_s']:.0f} control steps/s")
     lines.append(
         f"90 s games/s (one core): R-R {fmt(report['rr_games_per_s'])} (enclosed), "

@@ -44,7 +44,8 @@ def test_unknown_name_suggests_the_closest_and_lists_all():
     with pytest.raises(registry.PluginError) as info:
         registry.load("pursuer", "smrt")
     assert str(info.value) == (
-        "Unknown pursuer 'smrt'. Did you mean 'smart'? Available: policy, random, smart. "
+        "Unknown pursuer 'smrt'. Did you mean 'smart'? Available: anticipating, cooperative, "
+        "policy, random, smart. "
         "Plugins register under the entry-point group 'pegame.pursuers'."
     )
 
