@@ -234,6 +234,32 @@ def write_summary(means: dict, path: Path) -> None:
                 ]
                 text = ["–" if v is None else f"{100 * v:.1f}" for v in values]
                 lines.append(f"| {pursuer} | " + " | ".join(text) + " |")
+    lines += [
+        "",
+        "## Mean over the three speed ratios: hall / enclosed / brick",
+        "",
+        "| pursuer \\ evader | "
+        + " | ".join(f"{evader} ({conditions})" for conditions in CONDITIONS for evader in EVADERS)
+        + " |",
+        "|---|" + "---|" * (len(CONDITIONS) * len(EVADERS)),
+    ]
+    for pursuer in PURSUERS:
+        row = []
+        for conditions in CONDITIONS:
+            for evader in EVADERS:
+                per_map = []
+                for name in MAPS:
+                    values = [means.get((conditions, pursuer, evader, name, r)) for r in RATIOS]
+                    played = [v for v in values if v is not None]
+                    per_map.append(
+                        f"{100 * sum(played) / len(played):.0f}"
+                        + ("" if len(played) == len(RATIOS) else "*")
+                        if played
+                        else "–"
+                    )
+                row.append(" / ".join(per_map))
+        lines.append(f"| {pursuer} | " + " | ".join(row) + " |")
+    lines += ["", "\\* not every speed ratio played: the mean of those that were."]
     path.write_text("\n".join(lines) + "\n")
 
 
