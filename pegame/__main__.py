@@ -134,6 +134,9 @@ def main() -> None:
     """Console-script entry point; exits with the run's status."""
     register_schema()
     signal.signal(signal.SIGTERM, _terminate)
+    # SIGINT as well: Python leaves it ignored when the process starts with it ignored (a
+    # background job, a test runner's worker), and an interrupt must still stop the sweep.
+    signal.signal(signal.SIGINT, _terminate)
     try:
         check_plugin_choices(sys.argv[1:])
         _app()

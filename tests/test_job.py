@@ -207,8 +207,11 @@ SWEEP = [
 ]
 
 
-def start_sweep(tmp_path: Path, *extra: str) -> subprocess.Popen:
+def start_sweep(tmp_path: Path, *extra: str, sigint_ignored: bool = False) -> subprocess.Popen:
+    """The interrupt tests' sweep; ``sigint_ignored``: start it with SIGINT ignored, as a
+    background job or a test runner's worker would."""
     env = {k: v for k, v in os.environ.items() if k != "HYDRA_FULL_ERROR"}
+    ignore = (lambda: signal.signal(signal.SIGINT, signal.SIG_IGN)) if sigint_ignored else None
     return subprocess.Popen(
         [
             sys.executable,
@@ -224,6 +227,7 @@ def start_sweep(tmp_path: Path, *extra: str) -> subprocess.Popen:
         stderr=subprocess.PIPE,
         env=env,
         start_new_session=True,
+        preexec_fn=ignore,
     )
 
 
@@ -253,10 +257,10 @@ def alive(pid: int) -> bool:
     return state != "Z"
 
 
-def interrupt_mid_sweep(tmp_path: Path, how) -> list[int]:
+def interrupt_mid_sweep(tmp_path: Path, how, sigint_ignored: bool = False) -> list[int]:
     """Start a two-worker joblib sweep, wait until both jobs stored games, interrupt it with
     ``how(proc)``; return the worker PIDs it had."""
-    proc = start_sweep(tmp_path)
+    proc = start_sweep(tmp_path, sigint_ignored=sigint_ignored)
     deadline = time.monotonic() + 240
     while time.monotonic() < deadline:
         counts = games_stored(tmp_path)
@@ -304,10 +308,13 @@ def test_sigterm_of_the_sweep_parent_stops_its_workers(tmp_path):
     assert_workers_stop(tmp_path, workers)
 
 
-def test_ctrl_c_stops_the_sweep_and_its_workers(tmp_path):
+@pytest.mark.parametrize("sigint_ignored", [False, True], ids=["terminal", "started-ignored"])
+def test_ctrl_c_stops_the_sweep_and_its_workers(tmp_path, sigint_ignored):
+    # started-ignored: a sweep launched with SIGINT ignored (in the background, or by a test
+    # runner's worker) ran to the end and exited 0 on an interrupt
     def ctrl_c(proc):
         os.killpg(proc.pid, signal.SIGINT)  # the terminal signals the whole foreground group
         assert proc.wait(timeout=60) == 130
 
-    workers = interrupt_mid_sweep(tmp_path, ctrl_c)
+    workers = interrupt_mid_sweep(tmp_path, ctrl_c, sigint_ignored)
     assert_workers_stop(tmp_path, workers)
