@@ -54,7 +54,7 @@ import numpy as np
 
 from pegame.api import PursuerObservation
 from pegame.errors import require
-from pegame.pursuers.smart import LOOKAHEAD_TIME, SEARCH, TRACK, SmartPursuer
+from pegame.pursuers.smart import LOOKAHEAD_TIME, TRACK, SmartPursuer
 from pegame.types import Plan, Pose, Velocity, clamp, wrap_angle
 from pegame.visibility import visibility_region
 
@@ -141,12 +141,7 @@ class AnticipatingPursuer(SmartPursuer):
                     0.0, clamp(self.config.k_heading * error, self.context.pursuer.w_max)
                 )
             self._search(observation)  # looked and did not see it: go to the estimate
-        if self.mode == SEARCH:
-            command = self.follower.command(observation.pose)
-            if not self.follower.done:
-                return command
-            self._start_scan(observation)
-        return Velocity(0.0, self._scan_sign * self.config.scan_rate)
+        return self._search_or_scan(observation)
 
     # -- tracking
 

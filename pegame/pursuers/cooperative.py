@@ -295,9 +295,4 @@ class CooperativePursuer(SmartPursuer):
             return self._track(replace(observation, detection=row[self.tracking]))
         if self.tracking is not None or self.mode == TRACK:
             self.decide(observation)  # just lost it (or handed it over): a task now
-        if self.mode == SEARCH:
-            command = self.follower.command(observation.pose)
-            if not self.follower.done:
-                return command
-            self._start_scan(observation)
-        return Velocity(0.0, self._scan_sign * self.config.scan_rate)
+        return self._search_or_scan(observation)

@@ -113,6 +113,11 @@ class SmartPursuer(Pursuer):
         if self.mode == TRACK:
             # Just lost the evader: head for the estimate now rather than at the next decision.
             self._search(observation)
+        return self._search_or_scan(observation)
+
+    def _search_or_scan(self, observation: PursuerObservation) -> Velocity:
+        """Not tracking: follow the path to the estimate (SEARCH), then turn in place at
+        ``scan_rate`` (SCAN) once it is reached."""
         if self.mode == SEARCH:
             command = self.follower.command(observation.pose)
             if not self.follower.done:
