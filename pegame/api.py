@@ -38,6 +38,7 @@ from pegame.types import (
     SensorFrame,
     Velocity,
     clamp,
+    value_type,
     wrap_angle,
 )
 
@@ -80,7 +81,7 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True, eq=False)
+@value_type(eq=False)
 class PursuerTeam:
     """What a pursuer knows of its team at one tick (a team game's; None in a 1v1 game).
 
@@ -101,7 +102,7 @@ class PursuerTeam:
     union: Region
 
 
-@dataclass(frozen=True, eq=False)
+@value_type(eq=False)
 class PursuerObservation:
     """What the pursuer strategy is given at each tick.
 
@@ -124,7 +125,7 @@ class PursuerObservation:
     team: PursuerTeam | None = None
 
 
-@dataclass(frozen=True)
+@value_type
 class EvaderObservation:
     """What the evader strategy is given: time (s), its own pose and the pursuer's pose.
 
@@ -146,7 +147,7 @@ class EvaderObservation:
     member: int = 0
 
 
-@dataclass(frozen=True)
+@value_type
 class Context:
     """What every plugin is built with, fixed for one game.
 
@@ -162,7 +163,7 @@ class Context:
     decision_dt: float
 
 
-@dataclass(frozen=True, eq=False)
+@value_type(eq=False)
 class Tick:
     """Everything that happened at one control tick, as the recorder receives it.
 
@@ -187,7 +188,7 @@ class Tick:
     team: TeamTick | None = None
 
 
-@dataclass(frozen=True, eq=False)
+@value_type(eq=False)
 class TeamTick:
     """Every member's part of one control tick (the :class:`Tick`'s own fields are
     pursuer 0's and evader 0's: its detection and belief of evader 0, and in_view whether

@@ -152,22 +152,15 @@ class TickLoop:
             else TeamMetrics(context, self.n_pursuers, self.n_evaders)
         )
         self.step = 0
+        self.time = 0.0  # s, simulation time of the current tick: step * control_dt
+        self.evader_first = turn_order == "evader_first"
         self.pursuer_plans = [Plan()] * self.n_pursuers
         self.evader_plans = [Plan()] * self.n_evaders
-
-    @property
-    def time(self) -> float:
-        """Simulation time of the current tick (s)."""
-        return self.step * self.context.control_dt
 
     @property
     def done(self) -> bool:
         """True once every tick of the game has been played."""
         return self.step >= self.ticks
-
-    @property
-    def evader_first(self) -> bool:
-        return self.turn_order == "evader_first"
 
     # -- member 0's view, the 1v1 game's names
 
@@ -325,15 +318,9 @@ class TickLoop:
         """Play the current tick with the external roles' ``commands`` (role -> velocity,
         or one velocity per member in a team game), step the simulator and sense the next
         tick. Returns the tick that was played."""
-        if self.done:
+        if self.step >= self.ticks:
             raise RuntimeError("The game is over: every tick has been played.")
-        commanded: dict[str, list[Velocity]] = {}
-        if commands:
-            for role, command in commands.items():
-                commanded[role] = [command] if isinstance(command, Velocity) else list(command)
-        missing = [role for role in self.external if role not in commanded]
-        if missing:
-            raise ValueError(f"No command for the external role(s) {missing}.")
+        commanded = self._commanded(commands) if commands or self.external else {}
         deciding = self.step % self.decide_every == 0
         evaders, pursuers = self.evader_strategies, self.pursuer_strategies
         if self.evader_first:
@@ -419,12 +406,30 @@ class TickLoop:
         self.recorder.log(tick)
         if self.evader_first:
             self._integrate(pursuers=p_cmds)
-            self.step += 1
+            self._next_tick()
         else:
             self._integrate(p_cmds, e_cmds)
-            self.step += 1
+            self._next_tick()
             self._sense()  # also after the last tick: the environments observe the final state
         return tick
+
+    def _next_tick(self) -> None:
+        self.step += 1
+        self.time = self.step * self.context.control_dt
+
+    def _commanded(
+        self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None
+    ) -> dict[str, list[Velocity]]:
+        """The external roles' commands as one list of velocities per role; ValueError
+        when an external role has none."""
+        commanded = {
+            role: [command] if isinstance(command, Velocity) else list(command)
+            for role, command in (commands or {}).items()
+        }
+        missing = [role for role in self.external if role not in commanded]
+        if missing:
+            raise ValueError(f"No command for the external role(s) {missing}.")
+        return commanded
 
     def _integrate(
         self, pursuers: Sequence[Velocity] | None = None, evaders: Sequence[Velocity] | None = None
