@@ -422,7 +422,7 @@ class Pursuer(Strategy):
         def __post_init__(self) -> None:
             for key in ("radius", "w_max", "a_max", "alpha_max"):
                 value = getattr(self, key)
-                require(value > 0, f"pursuer.{key}", "a positive number", value)
+                require(value > 0, key, "a positive number", value)
 
 
 class Evader(Strategy):
@@ -443,7 +443,7 @@ class Evader(Strategy):
         def __post_init__(self) -> None:
             for key in ("radius", "v_max", "w_max", "a_max", "alpha_max"):
                 value = getattr(self, key)
-                require(value > 0, f"evader.{key}", "a positive number", value)
+                require(value > 0, key, "a positive number", value)
 
 
 class Recorder(Plugin):

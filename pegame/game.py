@@ -335,7 +335,8 @@ class Scenario:
                     else {k: v for k, v in base.items() if k in body_keys}
                 )
                 cls = registry.load(role, name)
-                config = registry.make_config(role, cls, {**kept, **options})
+                node = f"team.{role}s[{index}]"
+                config = registry.make_config(role, cls, {**kept, **options}, node)
                 members[role].append((name, cls, config))
         return members
 

@@ -114,22 +114,23 @@ class PolicyOptions:
     )
 
     def check(self, role: str) -> None:
-        """Range checks, naming ``role.key``; an empty path is caught when the strategy is built."""
+        """Range checks (keys relative to the node); an empty path is caught when the
+        strategy is built."""
         require(
             self.path == "" or self.path.endswith(".npz") or ":" in self.path,
-            f"{role}.path",
+            "path",
             "a .npz policy file or 'package.module:function'",
             self.path,
         )
         require(
             role == "pursuer" or not self.belief,
-            f"{role}.belief",
+            "belief",
             "null or false (only the pursuer has a belief)",
             self.belief,
         )
         require(
             self.crop_cells is None or self.crop_cells >= 1,
-            f"{role}.crop_cells",
+            "crop_cells",
             "a whole number >= 1, or null",
             self.crop_cells,
         )
@@ -137,7 +138,7 @@ class PolicyOptions:
             value = getattr(self, key)
             require(
                 value is None or (value > 0 and math.isfinite(value)),
-                f"{role}.{key}",
+                key,
                 "a positive number, or null",
                 value,
             )

@@ -18,7 +18,7 @@ from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
 from pegame.api import INTERFACES, PLUGIN_KINDS, Plugin
-from pegame.errors import PegameError
+from pegame.errors import ConfigError, PegameError
 
 #: config group -> entry-point group, derived from :data:`pegame.api.PLUGIN_KINDS`
 GROUPS: dict[str, str] = {kind: spec.entry_point_group for kind, spec in PLUGIN_KINDS.items()}
@@ -134,12 +134,19 @@ def check_interface(group: str, name: str, point: EntryPoint, cls: Any) -> None:
         )
 
 
-def make_config(group: str, cls: type[Plugin], params: Mapping[str, Any]) -> Any:
+def make_config(
+    group: str, cls: type[Plugin], params: Mapping[str, Any], node: str | None = None
+) -> Any:
     """Build a validated ``cls.Config`` from a config node's ``params`` (without ``name``);
-    ConfigError names ``group.key`` and the allowed keys or range."""
+    ConfigError names the full key under the node (``group``, or ``node`` for a team
+    member, e.g. ``team.pursuers[1]``) and the allowed keys or range."""
     from pegame.config import typed
 
-    return typed(params, cls.Config, group)
+    node = node or group
+    try:
+        return typed(params, cls.Config, node)
+    except ConfigError as error:
+        raise error.under(node, group) from None
 
 
 def describe(group: str) -> list[tuple[str, str, str]]:

@@ -146,7 +146,7 @@ class Strict(Lenient):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(self.gain > 0, "gain", "a positive number", self.gain)
+            require(self.gain > 0, "speed", "a positive number", self.gain)
 
 
 def test_an_unregistered_plugin_is_refused_with_the_entry_point_group():

@@ -418,11 +418,12 @@ def test_spawn_sends_live_to_a_viewer_as_well_as_to_the_file(monkeypatch, tmp_pa
 
 def test_bad_recorder_options_are_config_errors():
     from pegame.errors import ConfigError
+    from pegame.registry import make_config
 
     with pytest.raises(ConfigError, match="recorder.flush_every"):
-        RerunRecorder.Config(flush_every=0)
+        make_config("recorder", RerunRecorder, {"flush_every": 0})
     with pytest.raises(ConfigError, match="recorder.jpeg_quality"):
-        RerunRecorder.Config(jpeg_quality=101)
+        make_config("recorder", RerunRecorder, {"jpeg_quality": 101})
 
 
 def test_particles_are_subsampled_and_coloured_by_weight(tmp_path):

@@ -14,7 +14,7 @@ import pytest
 from pegame.api import Detection, Detector, Simulator, fuse_detections
 from pegame.config import compose
 from pegame.detectors.oracle import OracleDetector
-from pegame.errors import ConfigError, SpawnError
+from pegame.errors import ConfigError, SpawnError, require
 from pegame.estimators.kalman import KalmanEstimator
 from pegame.game import Game, spawn, spawn_team, team_header, write_outcome
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid, save_map
@@ -101,6 +101,32 @@ def test_a_bad_team_size_is_a_config_error_naming_the_key_and_what_is_allowed(va
 def test_a_member_cannot_change_the_role_s_body():
     with pytest.raises(ConfigError, match=r"team.pursuers\[1\].radius"):
         team_game("team.pursuers=[smart,{name:random,radius:0.3}]")
+
+
+@pytest.mark.parametrize(
+    ("member", "key"),
+    [
+        ("{name:smart,k_v:-1}", "team.pursuers[1].k_v"),  # the plugin's own range check
+        ("{name:smart,kv:1}", "team.pursuers[1].kv"),  # an unknown key
+    ],
+)
+def test_a_bad_member_option_names_the_member_s_key(member, key):
+    with pytest.raises(ConfigError) as info:
+        team_game(f"team.pursuers=[random,{member}]")
+    assert f"'{key}'" in str(info.value)
+
+
+def test_a_check_written_under_its_group_is_moved_under_the_node():
+    """A plugin written before keys were relative names 'pursuer.gain' itself."""
+    with pytest.raises(ConfigError) as info:
+        require(False, "pursuer.gain", "a positive number", -1.0)
+    moved = info.value.under("team.pursuers[2]", "pursuer")
+    assert (
+        str(moved) == "Invalid value for 'team.pursuers[2].gain': -1.0. Allowed: a positive number."
+    )
+    assert str(info.value.under("pursuer", "pursuer")).startswith(
+        "Invalid value for 'pursuer.gain'"
+    )
 
 
 def test_a_heterogeneous_team_plays_one_plugin_per_member_with_its_own_options():

@@ -48,7 +48,7 @@ class OracleDetector(Detector):
             for key in ("evader_height", "camera_height"):
                 require(
                     getattr(self, key) > 0,
-                    f"detector.{key}",
+                    key,
                     "a positive height in m",
                     getattr(self, key),
                 )

@@ -93,26 +93,25 @@ class PerceptionConfig:
     false_positive_rate: float = 0.0  # 1/s, false detections per second (Poisson)
 
     def __post_init__(self) -> None:
-        key = "detector.{}".format
         if self.rate is not None:
             ok = math.isfinite(self.rate) and self.rate > 0
-            require(ok, key("rate"), "a rate > 0 Hz, or null for every control tick", self.rate)
+            require(ok, "rate", "a rate > 0 Hz, or null for every control tick", self.rate)
         ok = math.isfinite(self.latency) and self.latency >= 0
-        require(ok, key("latency"), "a delay >= 0 s", self.latency)
+        require(ok, "latency", "a delay >= 0 s", self.latency)
         if self.detection_range is not None:
             ok = math.isfinite(self.detection_range) and self.detection_range > 0
             allowed = "a range > 0 m, or null for the camera's far"
-            require(ok, key("detection_range"), allowed, self.detection_range)
+            require(ok, "detection_range", allowed, self.detection_range)
         for name in ("miss_probability", "miss_at_range", "occlusion_miss"):
-            require(0 <= getattr(self, name) <= 1, key(name), "[0, 1]", getattr(self, name))
+            require(0 <= getattr(self, name) <= 1, name, "[0, 1]", getattr(self, name))
         fraction = self.burst_miss_fraction
-        require(0 <= fraction < 1, key("burst_miss_fraction"), "[0, 1)", fraction)
+        require(0 <= fraction < 1, "burst_miss_fraction", "[0, 1)", fraction)
         ok = math.isfinite(self.burst_length) and self.burst_length > 0
-        require(ok, key("burst_length"), "a duration > 0 s", self.burst_length)
+        require(ok, "burst_length", "a duration > 0 s", self.burst_length)
         if self.miss_range_start is not None:
             ok = math.isfinite(self.miss_range_start) and self.miss_range_start >= 0
             allowed = "a range >= 0 m, or null for no range misses"
-            require(ok, key("miss_range_start"), allowed, self.miss_range_start)
+            require(ok, "miss_range_start", allowed, self.miss_range_start)
         for name, unit in (
             ("range_noise", "m"),
             ("range_noise_growth", "1/m"),
@@ -120,7 +119,7 @@ class PerceptionConfig:
             ("false_positive_rate", "1/s"),
         ):
             value = getattr(self, name)
-            require(math.isfinite(value) and value >= 0, key(name), f"a number >= 0 {unit}", value)
+            require(math.isfinite(value) and value >= 0, name, f"a number >= 0 {unit}", value)
 
     def check_context(self, context) -> None:
         """The checks that need the game's camera and control period (``context``): a

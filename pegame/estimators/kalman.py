@@ -52,7 +52,7 @@ class KalmanEstimator(Estimator):
         def __post_init__(self) -> None:
             for key in ("measurement_std", "accel_std"):
                 value = getattr(self, key)
-                require(0.0 < value < math.inf, f"estimator.{key}", "a finite std > 0", value)
+                require(0.0 < value < math.inf, key, "a finite std > 0", value)
 
     def __init__(self, config: Config, context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)

@@ -233,23 +233,22 @@ class ParticleFilter(Estimator):
         init_spread: float = 0.3  # m, std of the initial cloud around the first detection
 
         def __post_init__(self) -> None:
-            key = "estimator.{}".format
-            require(self.n_particles >= 1, key("n_particles"), "an integer >= 1", self.n_particles)
+            require(self.n_particles >= 1, "n_particles", "an integer >= 1", self.n_particles)
             allowed = "one of " + ", ".join(RESAMPLERS)
-            require(self.resampler in RESAMPLERS, key("resampler"), allowed, self.resampler)
-            require(0.0 <= self.rho <= 1.0, key("rho"), "[0, 1]", self.rho)
-            require(self.sigma > 0.0, key("sigma"), "a std > 0 m", self.sigma)
+            require(self.resampler in RESAMPLERS, "resampler", allowed, self.resampler)
+            require(0.0 <= self.rho <= 1.0, "rho", "[0, 1]", self.rho)
+            require(self.sigma > 0.0, "sigma", "a std > 0 m", self.sigma)
             turn = self.turn_rate_std
-            require(turn >= 0.0, key("turn_rate_std"), "a std >= 0 rad/s", turn)
+            require(turn >= 0.0, "turn_rate_std", "a std >= 0 rad/s", turn)
             boost = self.in_region_boost
-            require(boost >= 1.0, key("in_region_boost"), "a factor >= 1", boost)
-            require(0.0 <= self.miss_factor <= 1.0, key("miss_factor"), "[0, 1]", self.miss_factor)
+            require(boost >= 1.0, "in_region_boost", "a factor >= 1", boost)
+            require(0.0 <= self.miss_factor <= 1.0, "miss_factor", "[0, 1]", self.miss_factor)
             hz = self.miss_factor_hz
-            require(math.isfinite(hz) and hz > 0, key("miss_factor_hz"), "a rate > 0 Hz", hz)
-            require(self.init_spread >= 0.0, key("init_spread"), "a std >= 0 m", self.init_spread)
+            require(math.isfinite(hz) and hz > 0, "miss_factor_hz", "a rate > 0 Hz", hz)
+            require(self.init_spread >= 0.0, "init_spread", "a std >= 0 m", self.init_spread)
             for name in ("sigma", "turn_rate_std", "in_region_boost", "init_spread"):
                 value = getattr(self, name)
-                require(math.isfinite(value), key(name), "a finite number", value)
+                require(math.isfinite(value), name, "a finite number", value)
 
     def __init__(self, config: Config, context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)

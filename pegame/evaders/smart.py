@@ -102,15 +102,11 @@ class SmartEvader(Evader):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(
-                self.distance in DISTANCES, "evader.distance", ", ".join(DISTANCES), self.distance
-            )
-            require(
-                self.hide_margin >= 0, "evader.hide_margin", "a distance >= 0 m", self.hide_margin
-            )
+            require(self.distance in DISTANCES, "distance", ", ".join(DISTANCES), self.distance)
+            require(self.hide_margin >= 0, "hide_margin", "a distance >= 0 m", self.hide_margin)
             require(
                 self.candidate_stride >= 1,
-                "evader.candidate_stride",
+                "candidate_stride",
                 "an integer >= 1",
                 self.candidate_stride,
             )

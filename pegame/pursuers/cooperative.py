@@ -125,22 +125,22 @@ class CooperativePursuer(SmartPursuer):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(self.cover_value > 0, "pursuer.cover_value", "a value > 0", self.cover_value)
+            require(self.cover_value > 0, "cover_value", "a value > 0", self.cover_value)
             require(
                 self.kmeans_iterations >= 1,
-                "pursuer.kmeans_iterations",
+                "kmeans_iterations",
                 "a whole number >= 1",
                 self.kmeans_iterations,
             )
             require(
                 self.escape_stride >= 1,
-                "pursuer.escape_stride",
+                "escape_stride",
                 "a whole number >= 1",
                 self.escape_stride,
             )
             require(
                 self.escape_margin >= 0,
-                "pursuer.escape_margin",
+                "escape_margin",
                 "a distance >= 0 m",
                 self.escape_margin,
             )

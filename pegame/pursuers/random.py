@@ -27,7 +27,7 @@ class RandomPursuer(Pursuer):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(self.model in MODELS, "pursuer.model", " or ".join(MODELS), self.model)
+            require(self.model in MODELS, "model", " or ".join(MODELS), self.model)
 
     def __init__(self, config, context, rng) -> None:
         super().__init__(config, context, rng)

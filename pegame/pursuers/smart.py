@@ -71,14 +71,12 @@ class SmartPursuer(Pursuer):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(
-                self.standoff > 0, "pursuer.standoff", "a positive distance in m", self.standoff
-            )
-            require(self.k_w > 0, "pursuer.k_w", "a positive gain in rad/s", self.k_w)
-            require(self.k_v > 0, "pursuer.k_v", "a positive gain in 1/s", self.k_v)
+            require(self.standoff > 0, "standoff", "a positive distance in m", self.standoff)
+            require(self.k_w > 0, "k_w", "a positive gain in rad/s", self.k_w)
+            require(self.k_v > 0, "k_v", "a positive gain in 1/s", self.k_v)
             require(
                 self.scan_rate > 0,
-                "pursuer.scan_rate",
+                "scan_rate",
                 "a positive turn rate in rad/s",
                 self.scan_rate,
             )

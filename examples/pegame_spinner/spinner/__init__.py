@@ -20,9 +20,7 @@ class Spinner(Pursuer):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(
-                self.turn_rate > 0, "pursuer.turn_rate", "a positive rate in rad/s", self.turn_rate
-            )
+            require(self.turn_rate > 0, "turn_rate", "a positive rate in rad/s", self.turn_rate)
 
     def reset(self, pose) -> None:
         pass

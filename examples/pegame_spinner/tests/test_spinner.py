@@ -39,7 +39,8 @@ def test_spins_until_it_detects_then_steers_toward_the_box():
 
 
 def test_a_negative_turn_rate_is_a_config_error():
+    from pegame.registry import make_config
     from spinner import Spinner
 
     with pytest.raises(ConfigError, match="pursuer.turn_rate"):
-        Spinner.Config(turn_rate=-1.0)
+        make_config("pursuer", Spinner, {"turn_rate": -1.0})

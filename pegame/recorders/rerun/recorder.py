@@ -80,25 +80,25 @@ class RerunRecorder(Recorder):
             for key in ("flush_every", "live_flush_every", "trail_every"):
                 require(
                     getattr(self, key) >= 1,
-                    f"recorder.{key}",
+                    key,
                     "an integer >= 1",
                     getattr(self, key),
                 )
             for key in ("max_particles", "image_every"):
                 require(
                     getattr(self, key) >= 0,
-                    f"recorder.{key}",
+                    key,
                     "an integer >= 0",
                     getattr(self, key),
                 )
             require(
                 self.outline_rays >= 2,
-                "recorder.outline_rays",
+                "outline_rays",
                 "an integer >= 2",
                 self.outline_rays,
             )
             quality = self.jpeg_quality
-            require(1 <= quality <= 100, "recorder.jpeg_quality", "an integer in [1, 100]", quality)
+            require(1 <= quality <= 100, "jpeg_quality", "an integer in [1, 100]", quality)
 
     description = (
         "Rerun recording per game (<game_id>.rrd): map, agents, FOV, belief, plans, plots."

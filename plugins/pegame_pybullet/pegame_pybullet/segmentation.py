@@ -72,12 +72,10 @@ class SegmentationDetector(Detector):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(
-                self.min_pixels >= 1, "detector.min_pixels", "a whole number >= 1", self.min_pixels
-            )
+            require(self.min_pixels >= 1, "min_pixels", "a whole number >= 1", self.min_pixels)
             require(
                 self.surface_offset >= 0,
-                "detector.surface_offset",
+                "surface_offset",
                 "a distance >= 0 m",
                 self.surface_offset,
             )

@@ -152,20 +152,18 @@ class PybulletSimulator(Simulator):
         def __post_init__(self) -> None:
             for key in ("width", "height"):
                 value = getattr(self, key)
-                require(value >= 8, f"sim.{key}", "a whole number of pixels >= 8", value)
-            require(self.camera_hz > 0, "sim.camera_hz", "a positive rate in Hz", self.camera_hz)
-            require(
-                self.wall_height > 0, "sim.wall_height", "a positive height in m", self.wall_height
-            )
+                require(value >= 8, key, "a whole number of pixels >= 8", value)
+            require(self.camera_hz > 0, "camera_hz", "a positive rate in Hz", self.camera_hz)
+            require(self.wall_height > 0, "wall_height", "a positive height in m", self.wall_height)
             require(
                 0 < self.camera_height < self.wall_height,
-                "sim.camera_height",
+                "camera_height",
                 f"a height in m in (0, sim.wall_height = {self.wall_height})",
                 self.camera_height,
             )
             tilt, inset = self.camera_tilt, self.collision_inset
-            require(abs(tilt) < 0.5 * math.pi, "sim.camera_tilt", "(-pi/2, pi/2) rad", tilt)
-            require(inset >= 0, "sim.collision_inset", "a number of cells >= 0", inset)
+            require(abs(tilt) < 0.5 * math.pi, "camera_tilt", "(-pi/2, pi/2) rad", tilt)
+            require(inset >= 0, "collision_inset", "a number of cells >= 0", inset)
 
     def __init__(self, config, context, rng) -> None:
         super().__init__(config, context, rng)

@@ -16,6 +16,7 @@ import pybullet
 from pegame.api import Velocity
 from pegame.errors import ConfigError
 from pegame.grid import OccupancyGrid
+from pegame.registry import make_config
 from pegame.testing import WALL_X, missing_dependency_error
 from pegame.types import Pose
 from pegame_pybullet.bench import _rss_mb
@@ -144,10 +145,10 @@ def test_frames_are_rendered_at_camera_hz_and_reused_between(context):
 
 def test_bad_options_are_config_errors(context):
     with pytest.raises(ConfigError, match="sim.width"):
-        PybulletSimulator.Config(width=2)
+        make_config("sim", PybulletSimulator, {"width": 2})
     with pytest.raises(ConfigError, match="sim.camera_height"):
-        PybulletSimulator.Config(camera_height=3.0)
-    with pytest.raises(ConfigError, match="sim.collision_inset"):
+        make_config("sim", PybulletSimulator, {"camera_height": 3.0})
+    with pytest.raises(ConfigError, match="collision_inset"):
         make_sim(context, collision_inset=10)
 
 

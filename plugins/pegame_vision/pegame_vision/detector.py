@@ -76,7 +76,7 @@ class VisionDetector(Detector):
             super().__post_init__()
             require(
                 len(self.colours) > 0,
-                "detector.colours",
+                "colours",
                 "a non-empty list of '#rrggbb'",
                 self.colours,
             )
@@ -84,17 +84,15 @@ class VisionDetector(Detector):
                 try:
                     parse_hex(colour)
                 except ValueError:
-                    require(False, "detector.colours", "colours written '#rrggbb'", colour)
+                    require(False, "colours", "colours written '#rrggbb'", colour)
             require(
                 0 < self.hue_tolerance <= 90,
-                "detector.hue_tolerance",
+                "hue_tolerance",
                 "(0, 90] degrees",
                 self.hue_tolerance,
             )
             for key in ("min_saturation", "min_value"):
-                require(
-                    0 <= getattr(self, key) <= 1, f"detector.{key}", "[0, 1]", getattr(self, key)
-                )
+                require(0 <= getattr(self, key) <= 1, key, "[0, 1]", getattr(self, key))
             for key in (
                 "min_pixels",
                 "min_component",
@@ -104,13 +102,13 @@ class VisionDetector(Detector):
             ):
                 require(
                     getattr(self, key) >= 1,
-                    f"detector.{key}",
+                    key,
                     "a whole number >= 1",
                     getattr(self, key),
                 )
             require(
                 self.surface_offset >= 0,
-                "detector.surface_offset",
+                "surface_offset",
                 "a distance >= 0 m",
                 self.surface_offset,
             )

@@ -15,6 +15,7 @@ import numpy as np
 from pegame.api import Context, SensorFrame
 from pegame.errors import ConfigError
 from pegame.grid import OccupancyGrid
+from pegame.registry import make_config
 from pegame.testing import missing_dependency_error
 from pegame.types import Body, Camera, Pose
 from pegame_pybullet.segmentation import SegmentationDetector
@@ -99,7 +100,7 @@ def test_frames_without_images_are_a_clear_error(context):
 
 def test_bad_colours_are_config_errors():
     with pytest.raises(ConfigError, match="detector.colours"):
-        VisionDetector.Config(colours=["red"])
+        make_config("detector", VisionDetector, {"colours": ["red"]})
 
 
 def test_missing_opencv_is_an_import_error_naming_it():
