@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit, prange
 
 from pegame.envs.observations import AGE_SCALE
-from pegame.vector.exact import cell_by_division, cell_by_product, hypot, wrap_angle
+from pegame.vector.exact import cell_by_division, hypot, wrap_angle
 from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER
 
 
@@ -34,60 +34,120 @@ def _pose_features(world, x, y, theta, out, at):
     out[at + 3] = math.sin(theta)
 
 
+#: a lattice point within this many cells of a cell edge is not decided by the lattice
+_EDGE = 2.0**-20
+#: |u - floor(u) - 1/2| below which a lattice coordinate u is decided
+_DECIDED = 0.5 - _EDGE
+#: the largest size L (cells, see :func:`_lattice_crop`) for which the lattice decides
+_SIZE_LIMIT = 2.0**21
+
+
 @njit(cache=True, inline="always")
-def _fast_cells(world, x, y, c, s, cells, rotate):
-    """Every crop cell's flat index in world.crop_values by
-    :func:`pegame.vector.exact.cell_by_product` into ``cells``; returns whether all are
-    decided. Inlined with ``rotate`` a constant, so that each loop has no branch."""
+def _lattice_crop(world, x, y, c, s, out, at, cells):
+    """The crop's cells from the crop's lattice, into out[at:]; returns whether every
+    cell is decided (else out is to be redone by :func:`_divided_crop`).
+
+    Crop cell (i, j) lies at the grid-frame point (in cells) P + o_j A + o_i B, with
+    o = world.crop_centres (m), P = R(-yaw) (x - gx, y - gy) / res and A, B = R(-yaw)
+    R(theta) (e_x, e_y) / res the crop's axes; its coordinates are the row term
+    P + o_i B (once per row) plus the column term o_j A: a product and a sum per
+    coordinate and cell instead of the reference's rotation and division.
+
+    Why it picks the reference's cells. Let u = 2**-53 and L = (|x| + |y| + |gx| + |gy|
+    + 2 max|o|) / res, the size (cells) of every quantity either route forms. The
+    reference (:func:`pegame.envs.crop._crop`: 2 products, 3 sums, the grid rotation's 2
+    products and a sum, one division) and this route (fl(1 / res), the axes' 3
+    operations, the position's 4, the two lattice products and two sums) each round
+    at most 12 times, each time by at most u times a quantity of size at most L (1 + u)^12,
+    so each is within 13 u L of the exact quotient of the same float inputs, and the two
+    within 26 u L < 2**-26 cells of each other for L <= 2**21 (checked per game). A
+    coordinate q of this route with |q - floor(q) - 1/2| < 1/2 - 2**-20 (q - floor(q)
+    is exact) is more than 2**-20 > 26 u L from every whole number, so the reference's
+    quotient has the same floor: the same cell. A game with a coordinate that close to a
+    cell edge (about one game in 250 on random poses), with L too large, or whose
+    lattice leaves world.crop_table's border is redone by the division.
+
+    The crop's bounding box (its centre P plus the reach of its corners, |A| + |B| times
+    max|o|, and 2 cells for rounding) is checked inside world.crop_table, the pooled map
+    with a border of blocked cells, so that no cell needs a test against the map's edges;
+    the coordinates' cells are found in one vectorised pass (flat indices into ``cells``)
+    and looked up in a second, a gather that does not vectorise.
+    """
+    table, centres, frame = world.crop_table, world.crop_centres, world.crop_frame
+    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
+    padded_height, padded_width = table.shape
+    pad = (padded_width - world.pooled.shape[1]) // 2
+    inverse = 1.0 / res
+    ax, ay = (gc * c + gs * s) * inverse, (gc * s - gs * c) * inverse
+    bx, by = (gs * c - gc * s) * inverse, (gc * c + gs * s) * inverse
+    px, py = x - gx, y - gy
+    u0, v0 = (gc * px + gs * py) * inverse, (gc * py - gs * px) * inverse
+    n = centres.size
+    top = max(abs(centres[0]), abs(centres[n - 1]))
+    reach_u = (abs(ax) + abs(bx)) * top + 2.0
+    reach_v = (abs(ay) + abs(by)) * top + 2.0
+    size = (abs(x) + abs(y) + abs(gx) + abs(gy) + 2.0 * top) * inverse
+    if not (
+        size <= _SIZE_LIMIT
+        and u0 - reach_u > -pad
+        and u0 + reach_u < padded_width - pad
+        and v0 - reach_v > -pad
+        and v0 + reach_v < padded_height - pad
+    ):
+        return False  # also NaN
+    origin = float(pad * padded_width + pad)
+    width = float(padded_width)
+    bad = False
+    for i in range(n):
+        row_u = u0 + centres[i] * bx
+        row_v = v0 + centres[i] * by
+        for j in range(n):
+            u = row_u + centres[j] * ax
+            v = row_v + centres[j] * ay
+            col, row = np.floor(u), np.floor(v)
+            bad |= (abs(u - col - 0.5) >= _DECIDED) | (abs(v - row - 0.5) >= _DECIDED)
+            cells[i * n + j] = np.int64(row * width + col + origin)
+    flat = table.reshape(-1)
+    for k in range(n * n):
+        out[at + k] = flat[cells[k]]
+    return not bad
+
+
+@njit(cache=True)
+def _divided_crop(world, x, y, c, s, out, at):
+    """The crop's cells by the reference's own operations (:func:`pegame.envs.crop._crop`,
+    ``world_to_cell``'s division), into out[at:]."""
+    table, off_x, off_y, frame = world.crop_table, world.crop_x, world.crop_y, world.crop_frame
     height, width = world.pooled.shape
-    off_x, off_y = world.crop_x, world.crop_y
-    gx, gy, gc, gs = (
-        world.crop_frame[0],
-        world.crop_frame[1],
-        world.crop_frame[2],
-        world.crop_frame[3],
-    )
-    inverse = 1.0 / world.crop_frame[5]
-    decided = True
+    pad = (table.shape[1] - width) // 2
+    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
     for k in range(off_x.size):
         dx = x + (c * off_x[k] - s * off_y[k]) - gx
         dy = y + (s * off_x[k] + c * off_y[k]) - gy
-        if rotate:
+        if frame[4] != 0.0:
             dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
-        cells[k], ok = cell_by_product(dx, dy, inverse, height, width)
-        decided &= ok
-    return decided
+        cell = cell_by_division(dx, dy, res, height, width)
+        if cell == 0:
+            out[at + k] = 1.0
+        else:
+            row, col = (cell - 1) // width, (cell - 1) % width
+            out[at + k] = table[row + pad, col + pad]
 
 
 @njit(cache=True)
 def crop_into(world, x, y, theta, out, at, cells):
     """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
-    rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (same float
-    operations; ``cells``: int64 scratch of the crop's size) looked up in
-    world.crop_values (entry 0: off the map, blocked). The
-    cells come from products (:func:`pegame.vector.exact.cell_by_product`), and from the
-    division when any of them is not decided (a pose on cell edges). Returns whether the
-    division was needed. ``tests/test_vector_kernels.py`` compares the crop with the
-    reference on random poses and on poses whose cells lie on cell edges."""
+    rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int64
+    scratch of the crop's size): from the crop's lattice (:func:`_lattice_crop`), or by
+    the division when the lattice does not decide every cell (a pose on cell edges).
+    Returns whether the division was needed. ``tests/test_vector_kernels.py`` compares
+    the crop with the reference on random poses and on poses whose cells lie on cell
+    edges."""
     c, s = math.cos(theta), math.sin(theta)
-    if world.crop_frame[4] != 0.0:
-        decided = _fast_cells(world, x, y, c, s, cells, True)
-    else:
-        decided = _fast_cells(world, x, y, c, s, cells, False)
-    if not decided:
-        height, width = world.pooled.shape
-        off_x, off_y, frame = world.crop_x, world.crop_y, world.crop_frame
-        gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
-        for k in range(off_x.size):
-            dx = x + (c * off_x[k] - s * off_y[k]) - gx
-            dy = y + (s * off_x[k] + c * off_y[k]) - gy
-            if frame[4] != 0.0:
-                dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
-            cells[k] = cell_by_division(dx, dy, res, height, width)
-    values = world.crop_values
-    for k in range(cells.size):
-        out[at + k] = values[cells[k]]
-    return not decided
+    if _lattice_crop(world, x, y, c, s, out, at, cells):
+        return False
+    _divided_crop(world, x, y, c, s, out, at)
+    return True
 
 
 @njit(cache=True)

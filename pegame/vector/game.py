@@ -254,10 +254,19 @@ def _world(grid, context, settings: EnvSettings) -> World:
         crop._off_x,
         crop._off_y,
         np.array(crop._origin, dtype=np.float64),
-        np.concatenate([[1.0], crop._pooled.ravel()]).astype(np.float32),
+        _bordered(crop._pooled, crop._off_x, grid.resolution),
+        np.ascontiguousarray(crop._off_x[: settings.crop_cells]),
         np.concatenate([[True], grid.blocked.ravel()]),
         np.array([x0, y0, 2.0 / (x1 - x0), 2.0 / (y1 - y0), math.hypot(x1 - x0, y1 - y0)]),
     )
+
+
+def _bordered(pooled: np.ndarray, offsets: np.ndarray, resolution: float) -> np.ndarray:
+    """Float32: ``pooled`` (1.0 blocked, 0.0 free) inside a border of blocked cells
+    wider than the crop's reach from any point of the map (its corner's distance, max
+    |offset| times sqrt 2 m, and 3 cells), the table of the crop's lattice route."""
+    pad = math.ceil(math.sqrt(2.0) * np.abs(offsets).max() / resolution) + 3
+    return np.pad(pooled.astype(np.float32), pad, constant_values=1.0)
 
 
 def _rules(scenario: Scenario) -> Rules:
