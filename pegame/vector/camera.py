@@ -82,7 +82,7 @@ def _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, rotated):
     return decided
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def segment_clear(world, ax, ay, bx, by, step):
     """:func:`pegame.visibility.sight._segment_clear` on the grid: True when no sample of
     the segment from (ax, ay) to (bx, by) (m), ``step`` m apart, lies in a blocked or
@@ -119,7 +119,7 @@ def segment_clear(world, ax, ay, bx, by, step):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def point_in_view(world, camera, px, py, ptheta, x, y):
     """:func:`pegame.visibility.in_view` of the map point (x, y) (m) from the camera at
     (px, py, ptheta)."""
@@ -131,7 +131,7 @@ def point_in_view(world, camera, px, py, ptheta, x, y):
     return segment_clear(world, px, py, x, y, 0.5 * world.frame[5])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def body_in_view(world, camera, px, py, ptheta, x, y, radius, centre):
     """:func:`pegame.visibility.body_in_view`: any SILHOUETTE point of the body of
     ``radius`` m at (x, y) in view; ``centre``: whether its centre (the first point,
@@ -147,14 +147,15 @@ def body_in_view(world, camera, px, py, ptheta, x, y, radius, centre):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def detect(world, rules, state, game):
     """The oracle detector's capture for ``game``'s current poses, into state.detected
     and state.detection (the pipeline's parts all off). Returns whether the evader's
     centre is in view."""
     camera = rules.camera
-    cx, cy, ctheta = state.poses[game, PURSUER]
-    ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
+    poses = state.poses
+    cx, cy, ctheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
+    ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
     state.detected[game] = False
     if not point_in_view(world, camera, cx, cy, ctheta, ex, ey):
         return False
@@ -182,22 +183,23 @@ def detect(world, rules, state, game):
     seen_bearing = math.atan2(0.5 * width - centre, focal)
     seen_range = depth / math.cos(seen_bearing)
     heading = ctheta + seen_bearing
-    out = state.detection[game]
-    out[BOX_X], out[BOX_Y], out[BOX_W], out[BOX_H] = left, top, box_w, bottom - top
-    out[DEPTH] = depth
-    out[SEEN_X] = cx + seen_range * math.cos(heading)
-    out[SEEN_Y] = cy + seen_range * math.sin(heading)
+    out, g = state.detection, game
+    out[g, BOX_X], out[g, BOX_Y], out[g, BOX_W], out[g, BOX_H] = left, top, box_w, bottom - top
+    out[g, DEPTH] = depth
+    out[g, SEEN_X] = cx + seen_range * math.cos(heading)
+    out[g, SEEN_Y] = cy + seen_range * math.sin(heading)
     state.detected[game] = True
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sense(world, rules, state, game):
     """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
     pursuer observation's memory of the last detection (``PursuerFeatures.remember``)."""
     centre = detect(world, rules, state, game)
-    px, py, ptheta = state.poses[game, PURSUER]
-    ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
+    poses = state.poses
+    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
+    ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
     state.in_view[game] = body_in_view(
         world, rules.camera, px, py, ptheta, ex, ey, rules.bodies[EVADER, RADIUS], centre
     )

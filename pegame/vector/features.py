@@ -24,7 +24,7 @@ def _unit(value):
     return low if low < 1.0 else 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pose_features(world, x, y, theta, out, at):
     """``_Features._pose``: normalised position, cos and sin of the heading."""
     x0, y0, sx, sy = world.extent[0], world.extent[1], world.extent[2], world.extent[3]
@@ -134,7 +134,7 @@ def _divided_crop(world, x, y, c, s, out, at):
             out[at + k] = table[row + pad, col + pad]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def crop_into(world, x, y, theta, out, at, cells):
     """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
     rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int64
@@ -150,11 +150,12 @@ def crop_into(world, x, y, theta, out, at, cells):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pursuer_row(world, rules, state, game, row, cells):
     """``PursuerFeatures.build`` (no belief part) of ``game`` into ``row``."""
     far = rules.camera[FAR]
-    px, py, ptheta = state.poses[game, PURSUER]
+    poses = state.poses
+    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
     _pose_features(world, px, py, ptheta, row, 0)
     row[4] = 1.0 if state.detected[game] else 0.0
     if not state.has_seen[game]:
@@ -167,12 +168,13 @@ def _pursuer_row(world, rules, state, game, row, cells):
     crop_into(world, px, py, ptheta, row, 8, cells)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _evader_row(world, rules, state, game, row, cells):
     """``EvaderFeatures.build`` of ``game`` into ``row``."""
     diagonal = world.extent[4]
     ex, ey, etheta = state.poses[game, EVADER]
-    px, py, ptheta = state.poses[game, PURSUER]
+    poses = state.poses
+    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
     _pose_features(world, ex, ey, etheta, row, 0)
     _pose_features(world, px, py, ptheta, row, 4)
     dx, dy = px - ex, py - ey
