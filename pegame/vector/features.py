@@ -25,9 +25,9 @@ def _unit(value):
 
 
 @njit(cache=True, inline="always")
-def _pose_features(world, x, y, theta, out, at):
+def _pose_features(extent, x, y, theta, out, at):
     """``_Features._pose``: normalised position, cos and sin of the heading."""
-    x0, y0, sx, sy = world.extent[0], world.extent[1], world.extent[2], world.extent[3]
+    x0, y0, sx, sy = extent[0], extent[1], extent[2], extent[3]
     out[at] = _unit((x - x0) * sx - 1.0)
     out[at + 1] = _unit((y - y0) * sy - 1.0)
     out[at + 2] = math.cos(theta)
@@ -43,7 +43,7 @@ _SIZE_LIMIT = 2.0**21
 
 
 @njit(cache=True, inline="always")
-def _lattice_crop(world, x, y, c, s, out, at, cells):
+def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells):
     """The crop's cells from the crop's lattice, into out[at:]; returns whether every
     cell is decided (else out is to be redone by :func:`_divided_crop`).
 
@@ -65,18 +65,19 @@ def _lattice_crop(world, x, y, c, s, out, at, cells):
     is exact) is more than 2**-20 > 26 u L from every whole number, so the reference's
     quotient has the same floor: the same cell. A game with a coordinate that close to a
     cell edge (about one game in 250 on random poses), with L too large, or whose
-    lattice leaves world.crop_table's border is redone by the division.
+    lattice leaves the table's border is redone by the division.
 
     The crop's bounding box (its centre P plus the reach of its corners, |A| + |B| times
-    max|o|, and 2 cells for rounding) is checked inside world.crop_table, the pooled map
+    max|o|, and 2 cells for rounding) is checked inside ``table`` = world.crop_table
+    (``frame`` = world.crop_frame, ``width`` the map's in cells), the pooled map
     with a border of blocked cells, so that no cell needs a test against the map's edges;
     the coordinates' cells are found in one vectorised pass (flat indices into ``cells``)
-    and looked up in a second, a gather that does not vectorise.
+    and looked up in a second, a gather that does not vectorise (an unsigned index: no
+    test for negative ones).
     """
-    table, centres, frame = world.crop_table, world.crop_centres, world.crop_frame
     gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
     padded_height, padded_width = table.shape
-    pad = (padded_width - world.pooled.shape[1]) // 2
+    pad = (padded_width - width) // 2
     inverse = 1.0 / res
     ax, ay = (gc * c + gs * s) * inverse, (gc * s - gs * c) * inverse
     bx, by = (gs * c - gc * s) * inverse, (gc * c + gs * s) * inverse
@@ -109,7 +110,7 @@ def _lattice_crop(world, x, y, c, s, out, at, cells):
             cells[i * n + j] = np.int64(row * width + col + origin)
     flat = table.reshape(-1)
     for k in range(n * n):
-        out[at + k] = flat[cells[k]]
+        out[at + k] = flat[np.uint64(cells[k])]
     return not bad
 
 
@@ -134,56 +135,54 @@ def _divided_crop(world, x, y, c, s, out, at):
             out[at + k] = table[row + pad, col + pad]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def crop_into(world, x, y, theta, out, at, cells):
     """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
     rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int64
     scratch of the crop's size): from the crop's lattice (:func:`_lattice_crop`), or by
-    the division when the lattice does not decide every cell (a pose on cell edges).
-    Returns whether the division was needed. ``tests/test_vector_kernels.py`` compares
-    the crop with the reference on random poses and on poses whose cells lie on cell
-    edges."""
+    the division when the lattice does not decide every cell (a pose on cell edges), as
+    the features' loop finds them. Returns whether the division was needed.
+    ``tests/test_vector_kernels.py`` compares the crop with the reference on random poses
+    and on poses whose cells lie on cell edges."""
     c, s = math.cos(theta), math.sin(theta)
-    if _lattice_crop(world, x, y, c, s, out, at, cells):
+    table, centres, frame = world.crop_table, world.crop_centres, world.crop_frame
+    if _lattice_crop(table, centres, frame, world.pooled.shape[1], x, y, c, s, out, at, cells):
         return False
     _divided_crop(world, x, y, c, s, out, at)
     return True
 
 
 @njit(cache=True, inline="always")
-def _pursuer_row(world, rules, state, game, row, cells):
-    """``PursuerFeatures.build`` (no belief part) of ``game`` into ``row``."""
-    far = rules.camera[FAR]
-    poses = state.poses
+def _pursuer_row(extent, poses, detected, has_seen, seen, steps, far, dt, game, row):
+    """``PursuerFeatures.build`` (no belief part, no crop) of ``game`` into ``row``, from
+    the state's arrays (a NamedTuple passed to an inlined function costs a reference
+    count per array)."""
     px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
-    _pose_features(world, px, py, ptheta, row, 0)
-    row[4] = 1.0 if state.detected[game] else 0.0
-    if not state.has_seen[game]:
+    _pose_features(extent, px, py, ptheta, row, 0)
+    row[4] = 1.0 if detected[game] else 0.0
+    if not has_seen[game]:
         row[5], row[6], row[7] = 1.0, 0.0, 1.0
     else:
-        dx, dy = state.seen[game, 1] - px, state.seen[game, 2] - py
+        dx, dy = seen[game, 1] - px, seen[game, 2] - py
         row[5] = min(1.0, hypot(dx, dy) / far)
         row[6] = wrap_angle(math.atan2(dy, dx) - ptheta) / math.pi
-        row[7] = min(1.0, (state.steps[game] * rules.control_dt - state.seen[game, 0]) / AGE_SCALE)
-    crop_into(world, px, py, ptheta, row, 8, cells)
+        row[7] = min(1.0, (steps[game] * dt - seen[game, 0]) / AGE_SCALE)
 
 
 @njit(cache=True, inline="always")
-def _evader_row(world, rules, state, game, row, cells):
-    """``EvaderFeatures.build`` of ``game`` into ``row``."""
-    diagonal = world.extent[4]
-    ex, ey, etheta = state.poses[game, EVADER]
-    poses = state.poses
+def _evader_row(extent, poses, game, row):
+    """``EvaderFeatures.build`` (no crop) of ``game`` into ``row``."""
+    diagonal = extent[4]
+    ex, ey, etheta = poses[game, EVADER, 0], poses[game, EVADER, 1], poses[game, EVADER, 2]
     px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
-    _pose_features(world, ex, ey, etheta, row, 0)
-    _pose_features(world, px, py, ptheta, row, 4)
+    _pose_features(extent, ex, ey, etheta, row, 0)
+    _pose_features(extent, px, py, ptheta, row, 4)
     dx, dy = px - ex, py - ey
     c, s = math.cos(etheta), math.sin(etheta)
     row[8] = _unit((c * dx + s * dy) / diagonal)
     row[9] = _unit((-s * dx + c * dy) / diagonal)
     row[10] = math.cos(ptheta - etheta)
     row[11] = math.sin(ptheta - etheta)
-    crop_into(world, ex, ey, etheta, row, 12, cells)
 
 
 #: games per block of the features' loop: one crop scratch array per block, since an
@@ -193,12 +192,26 @@ _BLOCK = 64
 
 @njit(cache=True)
 def _features_block(world, rules, state, out, pursuer, block):
+    """The rows of the games of ``block``: the arrays are taken out of the NamedTuples
+    once per block, not per game."""
     cells = np.empty(world.crop_x.size, np.int64)
+    extent, table, centres, frame = world.extent, world.crop_table, world.crop_centres, world.crop_frame
+    width = world.pooled.shape[1]
+    poses, detected, has_seen, seen, steps = (
+        state.poses, state.detected, state.has_seen, state.seen, state.steps
+    )
+    far, dt = rules.camera[FAR], rules.control_dt
+    role, at = (PURSUER, 8) if pursuer else (EVADER, 12)
     for game in range(block * _BLOCK, min(out.shape[0], (block + 1) * _BLOCK)):
+        row = out[game]
         if pursuer:
-            _pursuer_row(world, rules, state, game, out[game], cells)
+            _pursuer_row(extent, poses, detected, has_seen, seen, steps, far, dt, game, row)
         else:
-            _evader_row(world, rules, state, game, out[game], cells)
+            _evader_row(extent, poses, game, row)
+        x, y, theta = poses[game, role, 0], poses[game, role, 1], poses[game, role, 2]
+        c, s = math.cos(theta), math.sin(theta)
+        if not _lattice_crop(table, centres, frame, width, x, y, c, s, row, at, cells):
+            _divided_crop(world, x, y, c, s, row, at)
 
 
 @njit(cache=True)

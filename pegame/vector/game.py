@@ -262,11 +262,12 @@ def _world(grid, context, settings: EnvSettings) -> World:
 
 
 def _bordered(pooled: np.ndarray, offsets: np.ndarray, resolution: float) -> np.ndarray:
-    """Float32: ``pooled`` (1.0 blocked, 0.0 free) inside a border of blocked cells
-    wider than the crop's reach from any point of the map (its corner's distance, max
-    |offset| times sqrt 2 m, and 3 cells), the table of the crop's lattice route."""
+    """Uint8: ``pooled`` (1 blocked, 0 free) inside a border of blocked cells wider than
+    the crop's reach from any point of the map (its corner's distance, max |offset|
+    times sqrt 2 m, and 3 cells), the crop's look-up table (a quarter of float32's
+    cache lines: the look-up is the crop's larger part)."""
     pad = math.ceil(math.sqrt(2.0) * np.abs(offsets).max() / resolution) + 3
-    return np.pad(pooled.astype(np.float32), pad, constant_values=1.0)
+    return np.pad(pooled.astype(np.uint8), pad, constant_values=1)
 
 
 def _rules(scenario: Scenario) -> Rules:

@@ -55,7 +55,7 @@ class World(NamedTuple):
     grid inflated by the pursuer's and the evader's radius (the simulator's collision
     masks); pooled, crop_x, crop_y, crop_frame: the crop's pooled map, robot-frame cell
     offsets (m) and its map-to-cell numbers (:class:`pegame.envs.crop.LocalCrop`, float64);
-    crop_table: float32 (H + 2 pad, W + 2 pad): the pooled map (1.0 blocked, 0.0 free)
+    crop_table: uint8 (H + 2 pad, W + 2 pad): the pooled map (1 blocked, 0 free)
     in a border of ``pad`` blocked cells wider than the crop's reach, the crop's look-up
     table; crop_centres: float64 (crop_cells,): the crop's cell centres along one axis
     (m; crop_x and crop_y are their grid); sight_values: bool (1 + H * W,): True (off the grid), then ``blocked`` flat, the
