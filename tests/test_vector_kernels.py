@@ -146,8 +146,9 @@ def test_in_view_tests_are_the_visibility_functions(game):
         theta = math.atan2(ey - py, ex - px) + rng.uniform(-0.7, 0.7)
         pose = Pose(px, py, theta)
         centre = in_view(grid, camera, pose, (ex, ey))
-        assert batched_camera.point_in_view(world, numbers, px, py, theta, ex, ey) == centre
-        body = batched_camera.body_in_view(world, numbers, px, py, theta, ex, ey, 0.25, centre)
+        sight = world.frame, world.blocked, world.sight_values
+        assert batched_camera.point_in_view(*sight, numbers, px, py, theta, ex, ey) == centre
+        body = batched_camera.body_in_view(*sight, numbers, px, py, theta, ex, ey, 0.25, centre)
         assert body == body_in_view(grid, camera, pose, (ex, ey), 0.25)
         seen += centre
     assert 100 < seen < 2900  # both outcomes were tested
@@ -169,7 +170,8 @@ def test_segment_clear_on_cell_edges_is_the_sight_kernel(game):
         if i % 4 == 3:
             ax, ay = ax + rng.uniform(0, res), ay + rng.uniform(0, res)
         want = _segment_clear(grid.blocked, ax, ay, bx, by, 0.5 * res, grid.kernel_frame)
-        assert batched_camera.segment_clear(world, ax, ay, bx, by, 0.5 * res) == want
+        sight = world.frame, world.blocked, world.sight_values
+        assert batched_camera.segment_clear(*sight, ax, ay, bx, by, 0.5 * res) == want
         clear.append(want)
     assert 0.05 < np.mean(clear) < 0.95  # both outcomes were tested
 
@@ -192,7 +194,8 @@ def test_move_is_the_grid_simulators(game, a_max):
         v, w = rng.uniform(-0.7, 0.7), rng.uniform(-2.5, 2.5)
         agent.move(Velocity(v, w), 0.1)
         state.commands[0, 0] = (v, w)
-        kernels.move(world, rules, state, 0, 0, 0.1)
+        arrays = world.masks, world.frame, rules.bodies
+        kernels.move(*arrays, state.poses, state.velocities, state.commands, 0, 0, 0.1)
         assert tuple(state.poses[0, 0]) == (agent.pose.x, agent.pose.y, agent.pose.theta)
         if agent.limited:
             assert tuple(state.velocities[0, 0]) == (agent.velocity.v, agent.velocity.w)

@@ -69,13 +69,15 @@ def _ramp(current, target, limit):
 
 
 @njit(cache=True, inline="always")
-def move(world, rules, state, game, role, dt):
-    """Move ``role`` of ``game`` by its command for ``dt`` s (the grid simulator's move).
-    Elements are read by index, not through row views: a view costs a reference count."""
-    bodies, poses, velocities = rules.bodies, state.poses, state.velocities
+def move(masks, frame, bodies, poses, velocities, commands, game, role, dt):
+    """Move ``role`` of ``game`` by its command for ``dt`` s (the grid simulator's move),
+    from the world's masks and frame, rules.bodies and the state's poses, velocities and
+    commands. Elements are read by index, not through row views, and the arrays are
+    passed, not the NamedTuples: a view, and an inlined function given a NamedTuple, cost
+    a reference count per array."""
     x0, y0, theta0 = poses[game, role, 0], poses[game, role, 1], poses[game, role, 2]
-    v = _clamp(state.commands[game, role, 0], bodies[role, V_MAX])
-    w = _clamp(state.commands[game, role, 1], bodies[role, W_MAX])
+    v = _clamp(commands[game, role, 0], bodies[role, V_MAX])
+    w = _clamp(commands[game, role, 1], bodies[role, W_MAX])
     a_max, alpha_max = bodies[role, A_MAX], bodies[role, ALPHA_MAX]
     limited = not (math.isinf(a_max) and math.isinf(alpha_max))
     if limited:
@@ -89,8 +91,8 @@ def move(world, rules, state, game, role, dt):
         dx = radius * (math.sin(theta) - math.sin(theta0))
         dy = -radius * (math.cos(theta) - math.cos(theta0))
     tx, ty = x0 + dx, y0 + dy
-    n = max(1, ceil_of_hypot(tx - x0, ty - y0, world.frame[5]))
-    x, y = _sweep(world.masks[role], x0, y0, tx, ty, n, world.frame)
+    n = max(1, ceil_of_hypot(tx - x0, ty - y0, frame[5]))
+    x, y = _sweep(masks[role], x0, y0, tx, ty, n, frame)
     poses[game, role, 0], poses[game, role, 1], poses[game, role, 2] = x, y, wrap_angle(theta)
     if limited:
         stopped = hypot(tx - x, ty - y) > 1e-9
@@ -99,9 +101,10 @@ def move(world, rules, state, game, role, dt):
 
 
 @njit(cache=True, inline="always")
-def tally(state, game, dt):
-    """``TrackingMetrics.add`` for ``game``'s current tick, as running sums (no belief)."""
-    t, g, poses = state.tally, game, state.poses
+def tally(t, poses, in_view, detected, game, dt):
+    """``TrackingMetrics.add`` for ``game``'s current tick, as running sums (no belief),
+    into ``t`` = state.tally from the state's poses, in_view and detected."""
+    g = game
     px, py = poses[g, PURSUER, 0], poses[g, PURSUER, 1]
     ex, ey = poses[g, EVADER, 0], poses[g, EVADER, 1]
     tick = t[g, TICKS]
@@ -113,8 +116,8 @@ def tally(state, game, dt):
     t[g, LAST_PX], t[g, LAST_PY], t[g, LAST_EX], t[g, LAST_EY] = px, py, ex, ey
     dx, dy = px - ex, py - ey
     t[g, DISTANCE_SUM] += math.sqrt(dx * dx + dy * dy)
-    t[g, IN_VIEW] += state.in_view[g]
-    if state.detected[g]:
+    t[g, IN_VIEW] += in_view[g]
+    if detected[g]:
         t[g, DETECTED] += 1.0
         if t[g, IN_LOSS]:
             length = tick - t[g, LOSS_START]
@@ -130,31 +133,30 @@ def tally(state, game, dt):
     t[g, TICKS] = tick + 1.0
 
 
-@njit(cache=True, inline="always")
-def _play_tick(world, rules, state, game, table, table_role):
-    """One control tick of ``game`` in the loop's order (see :mod:`pegame.vector.game`):
-    the scripted command, the measures, the simulator's substeps, the next tick sensed."""
-    if table_role >= 0:
-        decision = state.steps[game] // rules.decide_every
-        state.commands[game, table_role, 0] = table[game, decision, 0]
-        state.commands[game, table_role, 1] = table[game, decision, 1]
-    tally(state, game, rules.control_dt)
-    dt = rules.control_dt / rules.substeps
-    for _ in range(rules.substeps):
-        move(world, rules, state, game, PURSUER, dt)
-        move(world, rules, state, game, EVADER, dt)
-    state.steps[game] += 1
-    sense(world, rules, state, game)
-    state.rewards[game] += state.detected[game]
-
-
 @njit(cache=True)
 def _play_game(world, rules, state, game, playing, ticks, table, table_role):
-    if playing[game]:
-        for _ in range(ticks):
-            if state.steps[game] >= rules.ticks:
-                break
-            _play_tick(world, rules, state, game, table, table_role)
+    """Up to ``ticks`` control ticks of ``game`` in the loop's order (see
+    :mod:`pegame.vector.game`): the scripted command, the measures, the simulator's
+    substeps, the next tick sensed. The arrays are taken out of the NamedTuples once."""
+    if not playing[game]:
+        return
+    masks, frame, bodies = world.masks, world.frame, rules.bodies
+    poses, velocities, commands, steps = state.poses, state.velocities, state.commands, state.steps
+    dt = rules.control_dt / rules.substeps
+    for _ in range(ticks):
+        if steps[game] >= rules.ticks:
+            break
+        if table_role >= 0:
+            decision = steps[game] // rules.decide_every
+            commands[game, table_role, 0] = table[game, decision, 0]
+            commands[game, table_role, 1] = table[game, decision, 1]
+        tally(state.tally, poses, state.in_view, state.detected, game, rules.control_dt)
+        for _ in range(rules.substeps):
+            move(masks, frame, bodies, poses, velocities, commands, game, PURSUER, dt)
+            move(masks, frame, bodies, poses, velocities, commands, game, EVADER, dt)
+        steps[game] += 1
+        sense(world, rules, state, game)
+        state.rewards[game] += state.detected[game]
 
 
 @njit(cache=True)
@@ -179,15 +181,20 @@ def play(world, rules, state, playing, ticks, table, table_role):
 
 
 @njit(cache=True)
+def _sense_game(world, rules, state, game):
+    sense(world, rules, state, game)
+
+
+@njit(cache=True)
 def _sense_serial(world, rules, state, games):
     for k in range(games.size):
-        sense(world, rules, state, games[k])
+        _sense_game(world, rules, state, games[k])
 
 
 @njit(cache=True, parallel=True)
 def _sense_parallel(world, rules, state, games):
     for k in prange(games.size):
-        sense(world, rules, state, games[k])
+        _sense_game(world, rules, state, games[k])
 
 
 def sense_games(world, rules, state, games):
