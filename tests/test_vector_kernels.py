@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from pegame.envs.crop import local_crop_reference
-from pegame.grid import OccupancyGrid
 from pegame.envs.vector import vector_env
+from pegame.grid import OccupancyGrid
 from pegame.sims.grid import _Agent
 from pegame.types import Pose, Velocity, wrap_angle
 from pegame.vector import camera as batched_camera

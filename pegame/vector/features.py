@@ -96,8 +96,7 @@ def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells):
         and v0 + reach_v < padded_height - pad
     ):
         return False  # also NaN
-    origin = float(pad * padded_width + pad)
-    width = float(padded_width)
+    origin, stride = float(pad * padded_width + pad), float(padded_width)
     bad = False
     for i in range(n):
         row_u = u0 + centres[i] * bx
@@ -107,7 +106,7 @@ def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells):
             v = row_v + centres[j] * ay
             col, row = np.floor(u), np.floor(v)
             bad |= (abs(u - col - 0.5) >= _DECIDED) | (abs(v - row - 0.5) >= _DECIDED)
-            cells[i * n + j] = np.int64(row * width + col + origin)
+            cells[i * n + j] = np.int64(row * stride + col + origin)
     flat = table.reshape(-1)
     for k in range(n * n):
         out[at + k] = flat[np.uint64(cells[k])]
@@ -195,11 +194,10 @@ def _features_block(world, rules, state, out, pursuer, block):
     """The rows of the games of ``block``: the arrays are taken out of the NamedTuples
     once per block, not per game."""
     cells = np.empty(world.crop_x.size, np.int64)
-    extent, table, centres, frame = world.extent, world.crop_table, world.crop_centres, world.crop_frame
-    width = world.pooled.shape[1]
-    poses, detected, has_seen, seen, steps = (
-        state.poses, state.detected, state.has_seen, state.seen, state.steps
-    )
+    extent, table, centres = world.extent, world.crop_table, world.crop_centres
+    frame, width = world.crop_frame, world.pooled.shape[1]
+    poses, detected, has_seen = state.poses, state.detected, state.has_seen
+    seen, steps = state.seen, state.steps
     far, dt = rules.camera[FAR], rules.control_dt
     role, at = (PURSUER, 8) if pursuer else (EVADER, 12)
     for game in range(block * _BLOCK, min(out.shape[0], (block + 1) * _BLOCK)):

@@ -191,7 +191,7 @@ class BatchedGame:
         state.rewards[:] = 0.0
         for role, command in commands.items():
             index = PURSUER if role == "pursuer" else EVADER
-            state.commands[playing, index] = command[playing]
+            np.copyto(state.commands[:, index], command, where=playing[:, None])
         opponent = self.opponent
         if opponent is None or opponent.table is not None:
             table = _NO_TABLE if opponent is None else opponent.table

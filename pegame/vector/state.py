@@ -58,8 +58,8 @@ class World(NamedTuple):
     crop_table: uint8 (H + 2 pad, W + 2 pad): the pooled map (1 blocked, 0 free)
     in a border of ``pad`` blocked cells wider than the crop's reach, the crop's look-up
     table; crop_centres: float64 (crop_cells,): the crop's cell centres along one axis
-    (m; crop_x and crop_y are their grid); sight_values: bool (1 + H * W,): True (off the grid), then ``blocked`` flat, the
-    line of sight's look-up table;
+    (m; crop_x and crop_y are their grid); sight_values: bool (1 + H * W,): True (off
+    the grid), then ``blocked`` flat, the line of sight's look-up table;
     extent: (x0, y0, 2 / width, 2 / height, diagonal) of the observations' normalisation.
     """
 
