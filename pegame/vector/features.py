@@ -43,15 +43,16 @@ _SIZE_LIMIT = 2.0**21
 
 
 @njit(cache=True, inline="always")
-def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells):
+def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
     """The crop's cells from the crop's lattice, into out[at:]; returns whether every
     cell is decided (else out is to be redone by :func:`_divided_crop`).
 
     Crop cell (i, j) lies at the grid-frame point (in cells) P + o_j A + o_i B, with
     o = world.crop_centres (m), P = R(-yaw) (x - gx, y - gy) / res and A, B = R(-yaw)
     R(theta) (e_x, e_y) / res the crop's axes; its coordinates are the row term
-    P + o_i B (once per row) plus the column term o_j A: a product and a sum per
-    coordinate and cell instead of the reference's rotation and division.
+    P + o_i B (once per row) plus the column term o_j A (once per game, into
+    ``columns``, float64 (2, crop_cells) scratch): a sum per coordinate and cell instead
+    of the reference's rotation and division.
 
     Why it picks the reference's cells. Let u = 2**-53 and L = (|x| + |y| + |gx| + |gy|
     + 2 max|o|) / res, the size (cells) of every quantity either route forms. The
@@ -97,13 +98,16 @@ def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells):
     ):
         return False  # also NaN
     origin, stride = float(pad * padded_width + pad), float(padded_width)
+    for j in range(n):
+        columns[0, j] = centres[j] * ax
+        columns[1, j] = centres[j] * ay
     bad = False
     for i in range(n):
         row_u = u0 + centres[i] * bx
         row_v = v0 + centres[i] * by
         for j in range(n):
-            u = row_u + centres[j] * ax
-            v = row_v + centres[j] * ay
+            u = row_u + columns[0, j]
+            v = row_v + columns[1, j]
             col, row = np.floor(u), np.floor(v)
             bad |= (abs(u - col - 0.5) >= _DECIDED) | (abs(v - row - 0.5) >= _DECIDED)
             cells[i * n + j] = np.int64(row * stride + col + origin)
@@ -145,7 +149,9 @@ def crop_into(world, x, y, theta, out, at, cells):
     and on poses whose cells lie on cell edges."""
     c, s = math.cos(theta), math.sin(theta)
     table, centres, frame = world.crop_table, world.crop_centres, world.crop_frame
-    if _lattice_crop(table, centres, frame, world.pooled.shape[1], x, y, c, s, out, at, cells):
+    columns = np.empty((2, centres.size))
+    width = world.pooled.shape[1]
+    if _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
         return False
     _divided_crop(world, x, y, c, s, out, at)
     return True
@@ -184,8 +190,8 @@ def _evader_row(extent, poses, game, row):
     row[11] = math.sin(ptheta - etheta)
 
 
-#: games per block of the features' loop: one crop scratch array per block, since an
-#: allocation per game costs about as much as the crop's arithmetic
+#: games per block of the features' loop: one set of crop scratch arrays per block, since
+#: an allocation per game costs a reference count and a heap call
 _BLOCK = 64
 
 
@@ -194,6 +200,7 @@ def _features_block(world, rules, state, out, pursuer, block):
     """The rows of the games of ``block``: the arrays are taken out of the NamedTuples
     once per block, not per game."""
     cells = np.empty(world.crop_x.size, np.int64)
+    columns = np.empty((2, world.crop_centres.size))
     extent, table, centres = world.extent, world.crop_table, world.crop_centres
     frame, width = world.crop_frame, world.pooled.shape[1]
     poses, detected, has_seen = state.poses, state.detected, state.has_seen
@@ -208,7 +215,7 @@ def _features_block(world, rules, state, out, pursuer, block):
             _evader_row(extent, poses, game, row)
         x, y, theta = poses[game, role, 0], poses[game, role, 1], poses[game, role, 2]
         c, s = math.cos(theta), math.sin(theta)
-        if not _lattice_crop(table, centres, frame, width, x, y, c, s, row, at, cells):
+        if not _lattice_crop(table, centres, frame, width, x, y, c, s, row, at, cells, columns):
             _divided_crop(world, x, y, c, s, row, at)
 
 
