@@ -80,7 +80,7 @@ def _sample_cells(frame, height, width, ax, ay, dx, dy, count, start, size, cell
     return decided
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
     """:func:`pegame.visibility.sight._segment_clear` on the grid: True when no sample of
     the segment from (ax, ay) to (bx, by) (m), ``step`` m apart, lies in a blocked or
