@@ -55,17 +55,18 @@ def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, colu
     of the reference's rotation and division.
 
     Why it picks the reference's cells. Let u = 2**-53 and L = (|x| + |y| + |gx| + |gy|
-    + 2 max|o|) / res, the size (cells) of every quantity either route forms. The
-    reference (:func:`pegame.envs.crop._crop`: 2 products, 3 sums, the grid rotation's 2
-    products and a sum, one division) and this route (fl(1 / res), the axes' 3
-    operations, the position's 4, the two lattice products and two sums) each round
-    at most 12 times, each time by at most u times a quantity of size at most L (1 + u)^12,
-    so each is within 13 u L of the exact quotient of the same float inputs, and the two
-    within 26 u L < 2**-26 cells of each other for L <= 2**21 (checked per game). A
+    + 4 max|o|) / res, a bound (cells) on every quantity either route forms. A rounding
+    errs by at most u times its quantity, and reaches a final coordinate through sums,
+    products by cos/sin (at most 1) and the scaling to cells, so it moves the coordinate
+    by at most u L (1 + u)^k. Per coordinate the reference (:func:`pegame.envs.crop._crop`)
+    rounds 14 times (5 for each of dx and dy, the grid rotation's 3, the division) and
+    this route 18 times (fl(1 / res) in the three scaled terms, the axes' 3 + 3, the
+    position's 2 + 3, the lattice's two products and two sums), so the two are within
+    34 u L (1 + u)^18 < 2**-26 cells of each other for L <= 2**21 (checked per game). A
     coordinate q of this route with |q - floor(q) - 1/2| < 1/2 - 2**-20 (q - floor(q)
-    is exact) is more than 2**-20 > 26 u L from every whole number, so the reference's
+    is exact) is more than 2**-20 > 2**-26 from every whole number, so the reference's
     quotient has the same floor: the same cell. A game with a coordinate that close to a
-    cell edge (about one game in 250 on random poses), with L too large, or whose
+    cell edge (under one game in 100 on random poses), with L too large, or whose
     lattice leaves the table's border is redone by the division.
 
     The crop's bounding box (its centre P plus the reach of its corners, |A| + |B| times
@@ -88,7 +89,7 @@ def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, colu
     top = max(abs(centres[0]), abs(centres[n - 1]))
     reach_u = (abs(ax) + abs(bx)) * top + 2.0
     reach_v = (abs(ay) + abs(by)) * top + 2.0
-    size = (abs(x) + abs(y) + abs(gx) + abs(gy) + 2.0 * top) * inverse
+    size = (abs(x) + abs(y) + abs(gx) + abs(gy) + 4.0 * top) * inverse
     if not (
         size <= _SIZE_LIMIT
         and u0 - reach_u > -pad
