@@ -10,11 +10,13 @@ import pytest
 
 from pegame.envs.crop import local_crop_reference
 from pegame.envs.vector import vector_env
+from pegame.grid import OccupancyGrid
 from pegame.sims.grid import _Agent
 from pegame.types import Pose, Velocity, wrap_angle
 from pegame.vector import camera as batched_camera
 from pegame.vector import exact, kernels
 from pegame.vector.features import crop_into
+from pegame.vector.game import _world
 from pegame.vector.state import new_state
 from pegame.visibility import body_in_view, in_view
 from pegame.visibility.sight import _segment_clear
@@ -100,6 +102,36 @@ def test_crop_on_cell_edges_is_the_reference_crop(game):
     assert np.mean(fast) > 0.9
 
 
+def test_crop_on_a_rotated_far_off_grid_is_the_reference_crop(game):
+    """The lattice route with the grid's own rotation and an origin far from 0 (the size
+    its error bound counts), on random poses, poses on the lattice of the grid's cells,
+    and poses off the map whose crop leaves the table's border (the division route)."""
+    grid = game.context.grid
+    settings = game.settings
+    data = np.where(grid.blocked, 100, 0).astype(np.int8)
+    rotated = OccupancyGrid(data, grid.resolution, origin=(-731.3, 402.7, 0.7), name="r")
+    world = _world(rotated, game.context, settings)
+    rng = np.random.default_rng(9)
+    res, (gx, gy, yaw) = rotated.resolution, rotated.origin
+    height, width = rotated.blocked.shape
+    out = np.empty(settings.crop_cells**2, np.float32)
+    cells = np.empty(settings.crop_cells**2, np.int64)
+    slow = []
+    for i in range(600):
+        u, v = rng.uniform(-40, width + 40) * res, rng.uniform(-40, height + 40) * res
+        if i % 2:
+            u, v = round(u / res) * res, round(v / res) * res  # on the cells' corners
+        x = gx + math.cos(yaw) * u - math.sin(yaw) * v
+        y = gy + math.sin(yaw) * u + math.cos(yaw) * v
+        theta = rng.uniform(-4, 4) if i % 4 < 2 else yaw + (i % 3) * math.pi / 2
+        slow.append(crop_into(world, x, y, theta, out, 0, cells))
+        want = local_crop_reference(
+            rotated, x, y, theta, settings.crop_cells, settings.crop_resolution
+        ).ravel()
+        np.testing.assert_array_equal(out, want)
+    assert 0.02 < np.mean(slow) < 0.98  # both routes were taken
+
+
 def test_in_view_tests_are_the_visibility_functions(game):
     world, grid, camera = game.world, game.context.grid, game.context.camera
     numbers = game.rules.camera
@@ -114,8 +146,9 @@ def test_in_view_tests_are_the_visibility_functions(game):
         theta = math.atan2(ey - py, ex - px) + rng.uniform(-0.7, 0.7)
         pose = Pose(px, py, theta)
         centre = in_view(grid, camera, pose, (ex, ey))
-        assert batched_camera.point_in_view(world, numbers, px, py, theta, ex, ey) == centre
-        body = batched_camera.body_in_view(world, numbers, px, py, theta, ex, ey, 0.25, centre)
+        sight = world.frame, world.blocked, world.sight_values
+        assert batched_camera.point_in_view(*sight, numbers, px, py, theta, ex, ey) == centre
+        body = batched_camera.body_in_view(*sight, numbers, px, py, theta, ex, ey, 0.25, centre)
         assert body == body_in_view(grid, camera, pose, (ex, ey), 0.25)
         seen += centre
     assert 100 < seen < 2900  # both outcomes were tested
@@ -137,7 +170,8 @@ def test_segment_clear_on_cell_edges_is_the_sight_kernel(game):
         if i % 4 == 3:
             ax, ay = ax + rng.uniform(0, res), ay + rng.uniform(0, res)
         want = _segment_clear(grid.blocked, ax, ay, bx, by, 0.5 * res, grid.kernel_frame)
-        assert batched_camera.segment_clear(world, ax, ay, bx, by, 0.5 * res) == want
+        sight = world.frame, world.blocked, world.sight_values
+        assert batched_camera.segment_clear(*sight, ax, ay, bx, by, 0.5 * res) == want
         clear.append(want)
     assert 0.05 < np.mean(clear) < 0.95  # both outcomes were tested
 
@@ -160,7 +194,8 @@ def test_move_is_the_grid_simulators(game, a_max):
         v, w = rng.uniform(-0.7, 0.7), rng.uniform(-2.5, 2.5)
         agent.move(Velocity(v, w), 0.1)
         state.commands[0, 0] = (v, w)
-        kernels.move(world, rules, state, 0, 0, 0.1)
+        arrays = world.masks, world.frame, rules.bodies
+        kernels.move(*arrays, state.poses, state.velocities, state.commands, 0, 0, 0.1)
         assert tuple(state.poses[0, 0]) == (agent.pose.x, agent.pose.y, agent.pose.theta)
         if agent.limited:
             assert tuple(state.velocities[0, 0]) == (agent.velocity.v, agent.velocity.w)

@@ -108,7 +108,7 @@ class _Batch:
                     f"per env, got shape {a.shape}."
                 )
             a = a.astype(np.float64)
-            live = a[playing]
+            live = a if playing.all() else a[playing]  # no copy in the common case
             if not np.isfinite(live).all():
                 raise ValueError(
                     f"{role} actions must be finite, got {a[playing][~np.isfinite(live).all(1)][0]!r}."

@@ -60,13 +60,11 @@ _CHUNK = 32
 
 
 @njit(cache=True, inline="always")
-def _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, rotated):
+def _sample_cells(frame, height, width, ax, ay, dx, dy, count, start, size, cells, rotated):
     """The cells (1 + flat index, 0 off the grid) of samples start..start + size - 1 of
     the segment into ``cells`` by :func:`pegame.vector.exact.cell_by_product`; returns
     whether all are decided. Inlined with ``rotated`` a constant (no branch in the loop).
     """
-    frame = world.frame
-    height, width = world.blocked.shape
     ox, oy, gc, gs = frame[0], frame[1], frame[2], frame[3]
     inverse, dt = 1.0 / frame[5], 1.0 / count
     decided = True
@@ -83,16 +81,17 @@ def _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, rotated):
 
 
 @njit(cache=True)
-def segment_clear(world, ax, ay, bx, by, step):
+def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
     """:func:`pegame.visibility.sight._segment_clear` on the grid: True when no sample of
     the segment from (ax, ay) to (bx, by) (m), ``step`` m apart, lies in a blocked or
     off-grid cell. The same samples and cells (the tests compare the two), found
     _CHUNK at a time from products (:func:`pegame.vector.exact.cell_by_product`; a chunk
     with a sample near a cell edge is found again by the division), then looked up in
-    world.sight_values (entry 0: off the grid, blocked); the test stops at the first
-    chunk with a blocked cell."""
-    frame, values = world.frame, world.sight_values
-    height, width = world.blocked.shape
+    ``values`` = world.sight_values (entry 0: off the grid, blocked); the test stops at
+    the first chunk with a blocked cell. ``frame``, ``blocked``: world.frame and
+    world.blocked. (The functions here take the world's arrays, not the World: an
+    inlined function given a NamedTuple pays a reference count per array.)"""
+    height, width = blocked.shape
     ox, oy, gc, gs, rotated, res = frame[0], frame[1], frame[2], frame[3], frame[4] != 0.0, frame[5]
     count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
     dx, dy = bx - ax, by - ay
@@ -101,9 +100,13 @@ def segment_clear(world, ax, ay, bx, by, step):
     for start in range(0, count + 1, _CHUNK):
         size = min(_CHUNK, count + 1 - start)
         if rotated:
-            decided = _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, True)
+            decided = _sample_cells(
+                frame, height, width, ax, ay, dx, dy, count, start, size, cells, True
+            )
         else:
-            decided = _sample_cells(world, ax, ay, dx, dy, count, start, size, cells, False)
+            decided = _sample_cells(
+                frame, height, width, ax, ay, dx, dy, count, start, size, cells, False
+            )
         if not decided:
             for j in range(size):
                 k = start + j
@@ -119,8 +122,8 @@ def segment_clear(world, ax, ay, bx, by, step):
     return True
 
 
-@njit(cache=True)
-def point_in_view(world, camera, px, py, ptheta, x, y):
+@njit(cache=True, inline="always")
+def point_in_view(frame, blocked, values, camera, px, py, ptheta, x, y):
     """:func:`pegame.visibility.in_view` of the map point (x, y) (m) from the camera at
     (px, py, ptheta)."""
     dx, dy = x - px, y - py
@@ -128,11 +131,11 @@ def point_in_view(world, camera, px, py, ptheta, x, y):
         return False
     if abs(wrap_angle(math.atan2(dy, dx) - ptheta)) > 0.5 * camera[FOV]:
         return False
-    return segment_clear(world, px, py, x, y, 0.5 * world.frame[5])
+    return segment_clear(frame, blocked, values, px, py, x, y, 0.5 * frame[5])
 
 
-@njit(cache=True)
-def body_in_view(world, camera, px, py, ptheta, x, y, radius, centre):
+@njit(cache=True, inline="always")
+def body_in_view(frame, blocked, values, camera, px, py, ptheta, x, y, radius, centre):
     """:func:`pegame.visibility.body_in_view`: any SILHOUETTE point of the body of
     ``radius`` m at (x, y) in view; ``centre``: whether its centre (the first point,
     x + 0 = x) is, already known from the detector."""
@@ -142,21 +145,23 @@ def body_in_view(world, camera, px, py, ptheta, x, y, radius, centre):
     distance = hypot(dx, dy)
     ax, ay = (-dy / distance, dx / distance) if distance > 0.0 else (0.0, 0.0)
     for k in _SILHOUETTE[1:]:
-        if point_in_view(world, camera, px, py, ptheta, x + k * radius * ax, y + k * radius * ay):
+        if point_in_view(
+            frame, blocked, values, camera, px, py, ptheta, x + k * radius * ax, y + k * radius * ay
+        ):
             return True
     return False
 
 
-@njit(cache=True)
-def detect(world, rules, state, game):
-    """The oracle detector's capture for ``game``'s current poses, into state.detected
-    and state.detection (the pipeline's parts all off). Returns whether the evader's
-    centre is in view."""
-    camera = rules.camera
-    cx, cy, ctheta = state.poses[game, PURSUER]
-    ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
-    state.detected[game] = False
-    if not point_in_view(world, camera, cx, cy, ctheta, ex, ey):
+@njit(cache=True, inline="always")
+def detect(frame, blocked, values, camera, radius, poses, detected, detection, game):
+    """The oracle detector's capture for ``game``'s current poses (state.poses) into
+    ``detected`` and ``detection`` (state's; the pipeline's parts all off; ``camera``:
+    rules.camera, ``radius``: the evader's). Returns whether the evader's centre is in
+    view."""
+    cx, cy, ctheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
+    ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
+    detected[game] = False
+    if not point_in_view(frame, blocked, values, camera, cx, cy, ctheta, ex, ey):
         return False
     distance = hypot(ex - cx, ey - cy)
     if not distance <= camera[DETECTION_RANGE]:
@@ -166,7 +171,7 @@ def detect(world, rules, state, game):
     depth = depth if depth > camera[NEAR] else camera[NEAR]
     # pinhole_box
     width, height, focal = camera[IMAGE_WIDTH], camera[IMAGE_HEIGHT], camera[FOCAL]
-    ratio = rules.bodies[EVADER, RADIUS] / distance
+    ratio = radius / distance
     half = math.asin(ratio if ratio < 1.0 else 1.0)
     left = 0.5 * width - focal * math.tan(bearing + half)
     left = left if left > 0.0 else 0.0
@@ -182,27 +187,33 @@ def detect(world, rules, state, game):
     seen_bearing = math.atan2(0.5 * width - centre, focal)
     seen_range = depth / math.cos(seen_bearing)
     heading = ctheta + seen_bearing
-    out = state.detection[game]
-    out[BOX_X], out[BOX_Y], out[BOX_W], out[BOX_H] = left, top, box_w, bottom - top
-    out[DEPTH] = depth
-    out[SEEN_X] = cx + seen_range * math.cos(heading)
-    out[SEEN_Y] = cy + seen_range * math.sin(heading)
-    state.detected[game] = True
+    out, g = detection, game
+    out[g, BOX_X], out[g, BOX_Y], out[g, BOX_W], out[g, BOX_H] = left, top, box_w, bottom - top
+    out[g, DEPTH] = depth
+    out[g, SEEN_X] = cx + seen_range * math.cos(heading)
+    out[g, SEEN_Y] = cy + seen_range * math.sin(heading)
+    detected[game] = True
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sense(world, rules, state, game):
     """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
-    pursuer observation's memory of the last detection (``PursuerFeatures.remember``)."""
-    centre = detect(world, rules, state, game)
-    px, py, ptheta = state.poses[game, PURSUER]
-    ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
+    pursuer observation's memory of the last detection (``PursuerFeatures.remember``).
+    The caller inlines it once per game, so that the NamedTuples' arrays are taken out
+    once."""
+    frame, blocked, values = world.frame, world.blocked, world.sight_values
+    camera, radius = rules.camera, rules.bodies[EVADER, RADIUS]
+    poses, detected, detection = state.poses, state.detected, state.detection
+    centre = detect(frame, blocked, values, camera, radius, poses, detected, detection, game)
+    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
+    ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
     state.in_view[game] = body_in_view(
-        world, rules.camera, px, py, ptheta, ex, ey, rules.bodies[EVADER, RADIUS], centre
+        frame, blocked, values, camera, px, py, ptheta, ex, ey, radius, centre
     )
-    if state.detected[game]:
-        state.seen[game, 0] = state.steps[game] * rules.control_dt
-        state.seen[game, 1] = state.detection[game, SEEN_X]
-        state.seen[game, 2] = state.detection[game, SEEN_Y]
+    if detected[game]:
+        seen = state.seen
+        seen[game, 0] = state.steps[game] * rules.control_dt
+        seen[game, 1] = detection[game, SEEN_X]
+        seen[game, 2] = detection[game, SEEN_Y]
         state.has_seen[game] = True

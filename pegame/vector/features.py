@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit, prange
 
 from pegame.envs.observations import AGE_SCALE
-from pegame.vector.exact import cell_by_division, cell_by_product, hypot, wrap_angle
+from pegame.vector.exact import cell_by_division, hypot, wrap_angle
 from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER
 
 
@@ -24,119 +24,200 @@ def _unit(value):
     return low if low < 1.0 else 1.0
 
 
-@njit(cache=True)
-def _pose_features(world, x, y, theta, out, at):
+@njit(cache=True, inline="always")
+def _pose_features(extent, x, y, theta, out, at):
     """``_Features._pose``: normalised position, cos and sin of the heading."""
-    x0, y0, sx, sy = world.extent[0], world.extent[1], world.extent[2], world.extent[3]
+    x0, y0, sx, sy = extent[0], extent[1], extent[2], extent[3]
     out[at] = _unit((x - x0) * sx - 1.0)
     out[at + 1] = _unit((y - y0) * sy - 1.0)
     out[at + 2] = math.cos(theta)
     out[at + 3] = math.sin(theta)
 
 
+#: a lattice point within this many cells of a cell edge is not decided by the lattice
+_EDGE = 2.0**-20
+#: |u - floor(u) - 1/2| below which a lattice coordinate u is decided
+_DECIDED = 0.5 - _EDGE
+#: the largest size L (cells, see :func:`_lattice_crop`) for which the lattice decides
+_SIZE_LIMIT = 2.0**21
+
+
 @njit(cache=True, inline="always")
-def _fast_cells(world, x, y, c, s, cells, rotate):
-    """Every crop cell's flat index in world.crop_values by
-    :func:`pegame.vector.exact.cell_by_product` into ``cells``; returns whether all are
-    decided. Inlined with ``rotate`` a constant, so that each loop has no branch."""
+def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
+    """The crop's cells from the crop's lattice, into out[at:]; returns whether every
+    cell is decided (else out is to be redone by :func:`_divided_crop`).
+
+    Crop cell (i, j) lies at the grid-frame point (in cells) P + o_j A + o_i B, with
+    o = world.crop_centres (m), P = R(-yaw) (x - gx, y - gy) / res and A, B = R(-yaw)
+    R(theta) (e_x, e_y) / res the crop's axes; its coordinates are the row term
+    P + o_i B (once per row) plus the column term o_j A (once per game, into
+    ``columns``, float64 (2, crop_cells) scratch): a sum per coordinate and cell instead
+    of the reference's rotation and division.
+
+    Why it picks the reference's cells. Let u = 2**-53 and L = (|x| + |y| + |gx| + |gy|
+    + 4 max|o|) / res, a bound (cells) on every quantity either route forms. A rounding
+    errs by at most u times its quantity, and reaches a final coordinate through sums,
+    products by cos/sin (at most 1) and the scaling to cells, so it moves the coordinate
+    by at most u L (1 + u)^k. Per coordinate the reference (:func:`pegame.envs.crop._crop`)
+    rounds 14 times (5 for each of dx and dy, the grid rotation's 3, the division) and
+    this route 18 times (fl(1 / res) in the three scaled terms, the axes' 3 + 3, the
+    position's 2 + 3, the lattice's two products and two sums), so the two are within
+    34 u L (1 + u)^18 < 2**-26 cells of each other for L <= 2**21 (checked per game). A
+    coordinate q of this route with |q - floor(q) - 1/2| < 1/2 - 2**-20 (q - floor(q)
+    is exact) is more than 2**-20 > 2**-26 from every whole number, so the reference's
+    quotient has the same floor: the same cell. A game with a coordinate that close to a
+    cell edge (under one game in 100 on random poses), with L too large, or whose
+    lattice leaves the table's border is redone by the division.
+
+    The crop's bounding box (its centre P plus the reach of its corners, |A| + |B| times
+    max|o|, and 2 cells for rounding) is checked inside ``table`` = world.crop_table
+    (``frame`` = world.crop_frame, ``width`` the map's in cells), the pooled map
+    with a border of blocked cells, so that no cell needs a test against the map's edges;
+    the coordinates' cells are found in one vectorised pass (flat indices into ``cells``)
+    and looked up in a second, a gather that does not vectorise (an unsigned index: no
+    test for negative ones).
+    """
+    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
+    padded_height, padded_width = table.shape
+    pad = (padded_width - width) // 2
+    inverse = 1.0 / res
+    ax, ay = (gc * c + gs * s) * inverse, (gc * s - gs * c) * inverse
+    bx, by = (gs * c - gc * s) * inverse, (gc * c + gs * s) * inverse
+    px, py = x - gx, y - gy
+    u0, v0 = (gc * px + gs * py) * inverse, (gc * py - gs * px) * inverse
+    n = centres.size
+    top = max(abs(centres[0]), abs(centres[n - 1]))
+    reach_u = (abs(ax) + abs(bx)) * top + 2.0
+    reach_v = (abs(ay) + abs(by)) * top + 2.0
+    size = (abs(x) + abs(y) + abs(gx) + abs(gy) + 4.0 * top) * inverse
+    if not (
+        size <= _SIZE_LIMIT
+        and u0 - reach_u > -pad
+        and u0 + reach_u < padded_width - pad
+        and v0 - reach_v > -pad
+        and v0 + reach_v < padded_height - pad
+    ):
+        return False  # also NaN
+    origin, stride = float(pad * padded_width + pad), float(padded_width)
+    for j in range(n):
+        columns[0, j] = centres[j] * ax
+        columns[1, j] = centres[j] * ay
+    bad = False
+    for i in range(n):
+        row_u = u0 + centres[i] * bx
+        row_v = v0 + centres[i] * by
+        for j in range(n):
+            u = row_u + columns[0, j]
+            v = row_v + columns[1, j]
+            col, row = np.floor(u), np.floor(v)
+            bad |= (abs(u - col - 0.5) >= _DECIDED) | (abs(v - row - 0.5) >= _DECIDED)
+            cells[i * n + j] = np.int64(row * stride + col + origin)
+    flat = table.reshape(-1)
+    for k in range(n * n):
+        out[at + k] = flat[np.uint64(cells[k])]
+    return not bad
+
+
+@njit(cache=True)
+def _divided_crop(world, x, y, c, s, out, at):
+    """The crop's cells by the reference's own operations (:func:`pegame.envs.crop._crop`,
+    ``world_to_cell``'s division), into out[at:]."""
+    table, off_x, off_y, frame = world.crop_table, world.crop_x, world.crop_y, world.crop_frame
     height, width = world.pooled.shape
-    off_x, off_y = world.crop_x, world.crop_y
-    gx, gy, gc, gs = (
-        world.crop_frame[0],
-        world.crop_frame[1],
-        world.crop_frame[2],
-        world.crop_frame[3],
-    )
-    inverse = 1.0 / world.crop_frame[5]
-    decided = True
+    pad = (table.shape[1] - width) // 2
+    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
     for k in range(off_x.size):
         dx = x + (c * off_x[k] - s * off_y[k]) - gx
         dy = y + (s * off_x[k] + c * off_y[k]) - gy
-        if rotate:
+        if frame[4] != 0.0:
             dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
-        cells[k], ok = cell_by_product(dx, dy, inverse, height, width)
-        decided &= ok
-    return decided
+        cell = cell_by_division(dx, dy, res, height, width)
+        if cell == 0:
+            out[at + k] = 1.0
+        else:
+            row, col = (cell - 1) // width, (cell - 1) % width
+            out[at + k] = table[row + pad, col + pad]
 
 
 @njit(cache=True)
 def crop_into(world, x, y, theta, out, at, cells):
     """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
-    rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (same float
-    operations; ``cells``: int64 scratch of the crop's size) looked up in
-    world.crop_values (entry 0: off the map, blocked). The
-    cells come from products (:func:`pegame.vector.exact.cell_by_product`), and from the
-    division when any of them is not decided (a pose on cell edges). Returns whether the
-    division was needed. ``tests/test_vector_kernels.py`` compares the crop with the
-    reference on random poses and on poses whose cells lie on cell edges."""
+    rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int64
+    scratch of the crop's size): from the crop's lattice (:func:`_lattice_crop`), or by
+    the division when the lattice does not decide every cell (a pose on cell edges), as
+    the features' loop finds them. Returns whether the division was needed.
+    ``tests/test_vector_kernels.py`` compares the crop with the reference on random poses
+    and on poses whose cells lie on cell edges."""
     c, s = math.cos(theta), math.sin(theta)
-    if world.crop_frame[4] != 0.0:
-        decided = _fast_cells(world, x, y, c, s, cells, True)
-    else:
-        decided = _fast_cells(world, x, y, c, s, cells, False)
-    if not decided:
-        height, width = world.pooled.shape
-        off_x, off_y, frame = world.crop_x, world.crop_y, world.crop_frame
-        gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
-        for k in range(off_x.size):
-            dx = x + (c * off_x[k] - s * off_y[k]) - gx
-            dy = y + (s * off_x[k] + c * off_y[k]) - gy
-            if frame[4] != 0.0:
-                dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
-            cells[k] = cell_by_division(dx, dy, res, height, width)
-    values = world.crop_values
-    for k in range(cells.size):
-        out[at + k] = values[cells[k]]
-    return not decided
+    table, centres, frame = world.crop_table, world.crop_centres, world.crop_frame
+    columns = np.empty((2, centres.size))
+    width = world.pooled.shape[1]
+    if _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
+        return False
+    _divided_crop(world, x, y, c, s, out, at)
+    return True
 
 
-@njit(cache=True)
-def _pursuer_row(world, rules, state, game, row, cells):
-    """``PursuerFeatures.build`` (no belief part) of ``game`` into ``row``."""
-    far = rules.camera[FAR]
-    px, py, ptheta = state.poses[game, PURSUER]
-    _pose_features(world, px, py, ptheta, row, 0)
-    row[4] = 1.0 if state.detected[game] else 0.0
-    if not state.has_seen[game]:
+@njit(cache=True, inline="always")
+def _pursuer_row(extent, poses, detected, has_seen, seen, steps, far, dt, game, row):
+    """``PursuerFeatures.build`` (no belief part, no crop) of ``game`` into ``row``, from
+    the state's arrays (a NamedTuple passed to an inlined function costs a reference
+    count per array)."""
+    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
+    _pose_features(extent, px, py, ptheta, row, 0)
+    row[4] = 1.0 if detected[game] else 0.0
+    if not has_seen[game]:
         row[5], row[6], row[7] = 1.0, 0.0, 1.0
     else:
-        dx, dy = state.seen[game, 1] - px, state.seen[game, 2] - py
+        dx, dy = seen[game, 1] - px, seen[game, 2] - py
         row[5] = min(1.0, hypot(dx, dy) / far)
         row[6] = wrap_angle(math.atan2(dy, dx) - ptheta) / math.pi
-        row[7] = min(1.0, (state.steps[game] * rules.control_dt - state.seen[game, 0]) / AGE_SCALE)
-    crop_into(world, px, py, ptheta, row, 8, cells)
+        row[7] = min(1.0, (steps[game] * dt - seen[game, 0]) / AGE_SCALE)
 
 
-@njit(cache=True)
-def _evader_row(world, rules, state, game, row, cells):
-    """``EvaderFeatures.build`` of ``game`` into ``row``."""
-    diagonal = world.extent[4]
-    ex, ey, etheta = state.poses[game, EVADER]
-    px, py, ptheta = state.poses[game, PURSUER]
-    _pose_features(world, ex, ey, etheta, row, 0)
-    _pose_features(world, px, py, ptheta, row, 4)
+@njit(cache=True, inline="always")
+def _evader_row(extent, poses, game, row):
+    """``EvaderFeatures.build`` (no crop) of ``game`` into ``row``."""
+    diagonal = extent[4]
+    ex, ey, etheta = poses[game, EVADER, 0], poses[game, EVADER, 1], poses[game, EVADER, 2]
+    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
+    _pose_features(extent, ex, ey, etheta, row, 0)
+    _pose_features(extent, px, py, ptheta, row, 4)
     dx, dy = px - ex, py - ey
     c, s = math.cos(etheta), math.sin(etheta)
     row[8] = _unit((c * dx + s * dy) / diagonal)
     row[9] = _unit((-s * dx + c * dy) / diagonal)
     row[10] = math.cos(ptheta - etheta)
     row[11] = math.sin(ptheta - etheta)
-    crop_into(world, ex, ey, etheta, row, 12, cells)
 
 
-#: games per block of the features' loop: one crop scratch array per block, since an
-#: allocation per game costs about as much as the crop's arithmetic
+#: games per block of the features' loop: one set of crop scratch arrays per block, since
+#: an allocation per game costs a reference count and a heap call
 _BLOCK = 64
 
 
 @njit(cache=True)
 def _features_block(world, rules, state, out, pursuer, block):
+    """The rows of the games of ``block``: the arrays are taken out of the NamedTuples
+    once per block, not per game."""
     cells = np.empty(world.crop_x.size, np.int64)
+    columns = np.empty((2, world.crop_centres.size))
+    extent, table, centres = world.extent, world.crop_table, world.crop_centres
+    frame, width = world.crop_frame, world.pooled.shape[1]
+    poses, detected, has_seen = state.poses, state.detected, state.has_seen
+    seen, steps = state.seen, state.steps
+    far, dt = rules.camera[FAR], rules.control_dt
+    role, at = (PURSUER, 8) if pursuer else (EVADER, 12)
     for game in range(block * _BLOCK, min(out.shape[0], (block + 1) * _BLOCK)):
+        row = out[game]
         if pursuer:
-            _pursuer_row(world, rules, state, game, out[game], cells)
+            _pursuer_row(extent, poses, detected, has_seen, seen, steps, far, dt, game, row)
         else:
-            _evader_row(world, rules, state, game, out[game], cells)
+            _evader_row(extent, poses, game, row)
+        x, y, theta = poses[game, role, 0], poses[game, role, 1], poses[game, role, 2]
+        c, s = math.cos(theta), math.sin(theta)
+        if not _lattice_crop(table, centres, frame, width, x, y, c, s, row, at, cells, columns):
+            _divided_crop(world, x, y, c, s, row, at)
 
 
 @njit(cache=True)

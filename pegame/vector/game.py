@@ -191,7 +191,7 @@ class BatchedGame:
         state.rewards[:] = 0.0
         for role, command in commands.items():
             index = PURSUER if role == "pursuer" else EVADER
-            state.commands[playing, index] = command[playing]
+            np.copyto(state.commands[:, index], command, where=playing[:, None])
         opponent = self.opponent
         if opponent is None or opponent.table is not None:
             table = _NO_TABLE if opponent is None else opponent.table
@@ -254,10 +254,20 @@ def _world(grid, context, settings: EnvSettings) -> World:
         crop._off_x,
         crop._off_y,
         np.array(crop._origin, dtype=np.float64),
-        np.concatenate([[1.0], crop._pooled.ravel()]).astype(np.float32),
+        _bordered(crop._pooled, crop._off_x, grid.resolution),
+        np.ascontiguousarray(crop._off_x[: settings.crop_cells]),
         np.concatenate([[True], grid.blocked.ravel()]),
         np.array([x0, y0, 2.0 / (x1 - x0), 2.0 / (y1 - y0), math.hypot(x1 - x0, y1 - y0)]),
     )
+
+
+def _bordered(pooled: np.ndarray, offsets: np.ndarray, resolution: float) -> np.ndarray:
+    """Uint8: ``pooled`` (1 blocked, 0 free) inside a border of blocked cells wider than
+    the crop's reach from any point of the map (its corner's distance, max |offset|
+    times sqrt 2 m, and 3 cells), the crop's look-up table (a quarter of float32's
+    cache lines: the look-up is the crop's larger part)."""
+    pad = math.ceil(math.sqrt(2.0) * np.abs(offsets).max() / resolution) + 3
+    return np.pad(pooled.astype(np.uint8), pad, constant_values=1)
 
 
 def _rules(scenario: Scenario) -> Rules:

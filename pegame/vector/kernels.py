@@ -68,18 +68,21 @@ def _ramp(current, target, limit):
     return current + _clamp(target - current, limit)
 
 
-@njit(cache=True)
-def move(world, rules, state, game, role, dt):
-    """Move ``role`` of ``game`` by its command for ``dt`` s (the grid simulator's move)."""
-    body = rules.bodies[role]
-    pose = state.poses[game, role]
-    x0, y0, theta0 = pose[0], pose[1], pose[2]
-    v = _clamp(state.commands[game, role, 0], body[V_MAX])
-    w = _clamp(state.commands[game, role, 1], body[W_MAX])
-    limited = not (math.isinf(body[A_MAX]) and math.isinf(body[ALPHA_MAX]))
+@njit(cache=True, inline="always")
+def move(masks, frame, bodies, poses, velocities, commands, game, role, dt):
+    """Move ``role`` of ``game`` by its command for ``dt`` s (the grid simulator's move),
+    from the world's masks and frame, rules.bodies and the state's poses, velocities and
+    commands. Elements are read by index, not through row views, and the arrays are
+    passed, not the NamedTuples: a view, and an inlined function given a NamedTuple, cost
+    a reference count per array."""
+    x0, y0, theta0 = poses[game, role, 0], poses[game, role, 1], poses[game, role, 2]
+    v = _clamp(commands[game, role, 0], bodies[role, V_MAX])
+    w = _clamp(commands[game, role, 1], bodies[role, W_MAX])
+    a_max, alpha_max = bodies[role, A_MAX], bodies[role, ALPHA_MAX]
+    limited = not (math.isinf(a_max) and math.isinf(alpha_max))
     if limited:
-        v = _ramp(state.velocities[game, role, 0], v, body[A_MAX] * dt)
-        w = _ramp(state.velocities[game, role, 1], w, body[ALPHA_MAX] * dt)
+        v = _ramp(velocities[game, role, 0], v, a_max * dt)
+        w = _ramp(velocities[game, role, 1], w, alpha_max * dt)
     theta = theta0 + w * dt
     if abs(w) < 1e-9:
         dx, dy = v * dt * math.cos(theta0), v * dt * math.sin(theta0)
@@ -88,72 +91,72 @@ def move(world, rules, state, game, role, dt):
         dx = radius * (math.sin(theta) - math.sin(theta0))
         dy = -radius * (math.cos(theta) - math.cos(theta0))
     tx, ty = x0 + dx, y0 + dy
-    n = max(1, ceil_of_hypot(tx - x0, ty - y0, world.frame[5]))
-    x, y = _sweep(world.masks[role], x0, y0, tx, ty, n, world.frame)
-    pose[0], pose[1], pose[2] = x, y, wrap_angle(theta)
+    n = max(1, ceil_of_hypot(tx - x0, ty - y0, frame[5]))
+    x, y = _sweep(masks[role], x0, y0, tx, ty, n, frame)
+    poses[game, role, 0], poses[game, role, 1], poses[game, role, 2] = x, y, wrap_angle(theta)
     if limited:
         stopped = hypot(tx - x, ty - y) > 1e-9
-        state.velocities[game, role, 0] = 0.0 if stopped else v
-        state.velocities[game, role, 1] = w
+        velocities[game, role, 0] = 0.0 if stopped else v
+        velocities[game, role, 1] = w
 
 
-@njit(cache=True)
-def tally(state, game, dt):
-    """``TrackingMetrics.add`` for ``game``'s current tick, as running sums (no belief)."""
-    row = state.tally[game]
-    px, py = state.poses[game, PURSUER, 0], state.poses[game, PURSUER, 1]
-    ex, ey = state.poses[game, EVADER, 0], state.poses[game, EVADER, 1]
-    tick = row[TICKS]
+@njit(cache=True, inline="always")
+def tally(t, poses, in_view, detected, game, dt):
+    """``TrackingMetrics.add`` for ``game``'s current tick, as running sums (no belief),
+    into ``t`` = state.tally from the state's poses, in_view and detected."""
+    g = game
+    px, py = poses[g, PURSUER, 0], poses[g, PURSUER, 1]
+    ex, ey = poses[g, EVADER, 0], poses[g, EVADER, 1]
+    tick = t[g, TICKS]
     if tick > 0:
-        dx, dy = px - row[LAST_PX], py - row[LAST_PY]
-        row[PURSUER_PATH] += math.sqrt(dx * dx + dy * dy)
-        dx, dy = ex - row[LAST_EX], ey - row[LAST_EY]
-        row[EVADER_PATH] += math.sqrt(dx * dx + dy * dy)
-    row[LAST_PX], row[LAST_PY], row[LAST_EX], row[LAST_EY] = px, py, ex, ey
+        dx, dy = px - t[g, LAST_PX], py - t[g, LAST_PY]
+        t[g, PURSUER_PATH] += math.sqrt(dx * dx + dy * dy)
+        dx, dy = ex - t[g, LAST_EX], ey - t[g, LAST_EY]
+        t[g, EVADER_PATH] += math.sqrt(dx * dx + dy * dy)
+    t[g, LAST_PX], t[g, LAST_PY], t[g, LAST_EX], t[g, LAST_EY] = px, py, ex, ey
     dx, dy = px - ex, py - ey
-    row[DISTANCE_SUM] += math.sqrt(dx * dx + dy * dy)
-    row[IN_VIEW] += state.in_view[game]
-    if state.detected[game]:
-        row[DETECTED] += 1.0
-        if row[IN_LOSS]:
-            length = tick - row[LOSS_START]
-            row[LONGEST_LOSS] = max(row[LONGEST_LOSS], length)
-            row[REACQUISITIONS] += 1.0
-            row[REACQUIRE_SUM] += length * dt
-            row[REACQUIRE_MAX] = max(row[REACQUIRE_MAX], length)
-            row[IN_LOSS] = 0.0
-    elif not row[IN_LOSS]:
-        row[IN_LOSS], row[LOSS_START] = 1.0, tick
-        if row[FIRST_LOSS] < 0:
-            row[FIRST_LOSS] = tick
-    row[TICKS] = tick + 1.0
-
-
-@njit(cache=True)
-def _play_tick(world, rules, state, game, table, table_role):
-    """One control tick of ``game`` in the loop's order (see :mod:`pegame.vector.game`):
-    the scripted command, the measures, the simulator's substeps, the next tick sensed."""
-    if table_role >= 0:
-        decision = state.steps[game] // rules.decide_every
-        state.commands[game, table_role, 0] = table[game, decision, 0]
-        state.commands[game, table_role, 1] = table[game, decision, 1]
-    tally(state, game, rules.control_dt)
-    dt = rules.control_dt / rules.substeps
-    for _ in range(rules.substeps):
-        move(world, rules, state, game, PURSUER, dt)
-        move(world, rules, state, game, EVADER, dt)
-    state.steps[game] += 1
-    sense(world, rules, state, game)
-    state.rewards[game] += state.detected[game]
+    t[g, DISTANCE_SUM] += math.sqrt(dx * dx + dy * dy)
+    t[g, IN_VIEW] += in_view[g]
+    if detected[g]:
+        t[g, DETECTED] += 1.0
+        if t[g, IN_LOSS]:
+            length = tick - t[g, LOSS_START]
+            t[g, LONGEST_LOSS] = max(t[g, LONGEST_LOSS], length)
+            t[g, REACQUISITIONS] += 1.0
+            t[g, REACQUIRE_SUM] += length * dt
+            t[g, REACQUIRE_MAX] = max(t[g, REACQUIRE_MAX], length)
+            t[g, IN_LOSS] = 0.0
+    elif not t[g, IN_LOSS]:
+        t[g, IN_LOSS], t[g, LOSS_START] = 1.0, tick
+        if t[g, FIRST_LOSS] < 0:
+            t[g, FIRST_LOSS] = tick
+    t[g, TICKS] = tick + 1.0
 
 
 @njit(cache=True)
 def _play_game(world, rules, state, game, playing, ticks, table, table_role):
-    if playing[game]:
-        for _ in range(ticks):
-            if state.steps[game] >= rules.ticks:
-                break
-            _play_tick(world, rules, state, game, table, table_role)
+    """Up to ``ticks`` control ticks of ``game`` in the loop's order (see
+    :mod:`pegame.vector.game`): the scripted command, the measures, the simulator's
+    substeps, the next tick sensed. The arrays are taken out of the NamedTuples once."""
+    if not playing[game]:
+        return
+    masks, frame, bodies = world.masks, world.frame, rules.bodies
+    poses, velocities, commands, steps = state.poses, state.velocities, state.commands, state.steps
+    dt = rules.control_dt / rules.substeps
+    for _ in range(ticks):
+        if steps[game] >= rules.ticks:
+            break
+        if table_role >= 0:
+            decision = steps[game] // rules.decide_every
+            commands[game, table_role, 0] = table[game, decision, 0]
+            commands[game, table_role, 1] = table[game, decision, 1]
+        tally(state.tally, poses, state.in_view, state.detected, game, rules.control_dt)
+        for _ in range(rules.substeps):
+            move(masks, frame, bodies, poses, velocities, commands, game, PURSUER, dt)
+            move(masks, frame, bodies, poses, velocities, commands, game, EVADER, dt)
+        steps[game] += 1
+        sense(world, rules, state, game)
+        state.rewards[game] += state.detected[game]
 
 
 @njit(cache=True)
@@ -178,15 +181,20 @@ def play(world, rules, state, playing, ticks, table, table_role):
 
 
 @njit(cache=True)
+def _sense_game(world, rules, state, game):
+    sense(world, rules, state, game)
+
+
+@njit(cache=True)
 def _sense_serial(world, rules, state, games):
     for k in range(games.size):
-        sense(world, rules, state, games[k])
+        _sense_game(world, rules, state, games[k])
 
 
 @njit(cache=True, parallel=True)
 def _sense_parallel(world, rules, state, games):
     for k in prange(games.size):
-        sense(world, rules, state, games[k])
+        _sense_game(world, rules, state, games[k])
 
 
 def sense_games(world, rules, state, games):

@@ -55,10 +55,11 @@ class World(NamedTuple):
     grid inflated by the pursuer's and the evader's radius (the simulator's collision
     masks); pooled, crop_x, crop_y, crop_frame: the crop's pooled map, robot-frame cell
     offsets (m) and its map-to-cell numbers (:class:`pegame.envs.crop.LocalCrop`, float64);
-    crop_values: float32 (1 + H * W,): the crop's value off the map (1.0, blocked), then
-    the pooled map's cells flat (1.0 blocked, 0.0 free), the look-up table of the crop;
-    sight_values: bool (1 + H * W,): True (off the grid), then ``blocked`` flat, the
-    line of sight's look-up table;
+    crop_table: uint8 (H + 2 pad, W + 2 pad): the pooled map (1 blocked, 0 free)
+    in a border of ``pad`` blocked cells wider than the crop's reach, the crop's look-up
+    table; crop_centres: float64 (crop_cells,): the crop's cell centres along one axis
+    (m; crop_x and crop_y are their grid); sight_values: bool (1 + H * W,): True (off
+    the grid), then ``blocked`` flat, the line of sight's look-up table;
     extent: (x0, y0, 2 / width, 2 / height, diagonal) of the observations' normalisation.
     """
 
@@ -69,7 +70,8 @@ class World(NamedTuple):
     crop_x: np.ndarray
     crop_y: np.ndarray
     crop_frame: np.ndarray
-    crop_values: np.ndarray
+    crop_table: np.ndarray
+    crop_centres: np.ndarray
     sight_values: np.ndarray
     extent: np.ndarray
 
