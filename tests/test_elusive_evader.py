@@ -27,6 +27,7 @@ class TestConformance(EvaderConformance):
         "hide_weight": -1,
         "horizon_p": 0,
         "exposed_penalty": -1,
+        "turn_weight": -1,
         "hide_margin": -1,
         "sight_angle_step": 0,
     }
@@ -111,3 +112,46 @@ def test_no_candidate_keeps_the_plan():
     evader = make(context)
     plan = evader.decide(EvaderObservation(0.0, Pose(1.0, 1.0), Pose(0.5, 0.5)))
     assert plan.goal is None
+
+
+def open_context(pursuer_speed: float = 0.5) -> Context:
+    """12 m x 12 m at 0.1 m with nothing to hide behind within the camera's 5 m range."""
+    grid = OccupancyGrid(np.full((120, 120), FREE, dtype=np.int8), 0.1)
+    return Context(grid, Body(0.2, pursuer_speed, 1.8), Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
+
+
+def test_turn_times_match_a_per_cell_reference():
+    """The vectorised turn times equal the plain per-cell formula, 0 inside the wedge and
+    (pi - fov / 2) / w_max straight behind the pursuer."""
+    context = pillar_context()
+    evader = make(context)
+    pursuer = Pose(3.1, 5.2, 2.6)
+    times = evader.turn_times(pursuer)
+    grid, fov, w_max = context.grid, context.camera.fov, context.pursuer.w_max
+    rng = np.random.default_rng(3)
+    for index in rng.integers(0, times.size, 200):
+        row, col = divmod(int(index), grid.width)
+        x, y = grid.cell_to_world(row, col)
+        off = abs(
+            math.remainder(math.atan2(y - pursuer.y, x - pursuer.x) - pursuer.theta, 2 * math.pi)
+        )
+        assert times[index] == pytest.approx(max(0.0, off - fov / 2) / w_max, abs=1e-12)
+    behind = grid.world_to_cell(pursuer.x - 2 * math.cos(2.6), pursuer.y - 2 * math.sin(2.6))
+    assert times[behind[0] * grid.width + behind[1]] == pytest.approx(
+        (math.pi - fov / 2) / w_max, abs=0.02
+    )
+
+
+def test_in_the_open_the_goal_is_where_the_pursuer_must_turn_longest():
+    """Nothing hides the evader within the camera's range: it goes behind the pursuer,
+    not just beside the wedge it stands in (regression: without the turn time every
+    exposed cell cost the same and the goal was the nearest cell out of view; tracked
+    98.9% in the hall at v_p/v_e = 1, like the smart evader)."""
+    context = open_context()
+    evader = make(context)
+    pursuer, me = Pose(6.0, 6.0, 0.0), Pose(7.5, 6.3, 0.0)  # 1.5 m ahead, in view
+    goal = evader.decide(EvaderObservation(0.0, me, pursuer)).goal
+    bearing = abs(math.atan2(goal[1] - pursuer.y, goal[0] - pursuer.x))
+    assert bearing > math.pi / 2  # across and behind the pursuer's heading
+    without = make(context, turn_weight=0.0).decide(EvaderObservation(0.0, me, pursuer)).goal
+    assert abs(math.atan2(without[1] - pursuer.y, without[0] - pursuer.x)) < bearing

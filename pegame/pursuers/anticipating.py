@@ -38,6 +38,17 @@ the escape of Algorithm 2, which hides the evader just outside the wedge, leaves
 reachable by a turn. Otherwise it plans to the mean and scans there as the smart pursuer
 does.
 
+No look after a detour: when the tracking servo turned away from the evader itself, to
+follow the detour round an obstacle its line of sight grazes (``detour``), the mass a
+look would turn to is the evader it just turned from. Looking there undoes the detour:
+the pursuer turns back, detects, turns away to detour, loses it, and stands turning in
+place while the evader walks off (a livelock measured on brick at v_p/v_e = 1 against
+the random evader: 17.7% tracked on seed 22, the smart pursuer 91.0%). So once a detour
+was commanded the pursuer does what the smart pursuer does, plans to the estimate and
+follows the path, and looks again only after a tracking tick whose straight approach is
+clear or once the search reaches the estimate and scans (that cell, seeds 0-39: 89.0%
+tracked before, 96.6% after, the smart pursuer 97.0%).
+
 Units and frames: metres, seconds and radians in the map frame of :mod:`pegame.grid`.
 Everything here is vectorised numpy over at most the estimator's particles; the one
 ray march is :func:`pegame.visibility.visibility_region` (numba, with its numpy
@@ -54,7 +65,7 @@ import numpy as np
 
 from pegame.api import PursuerObservation
 from pegame.errors import require
-from pegame.pursuers.smart import LOOKAHEAD_TIME, TRACK, SmartPursuer
+from pegame.pursuers.smart import LOOKAHEAD_TIME, SEARCH, TRACK, SmartPursuer
 from pegame.types import Plan, Pose, Velocity, clamp, wrap_angle
 from pegame.visibility import visibility_region
 
@@ -115,6 +126,7 @@ class AnticipatingPursuer(SmartPursuer):
         self._seen_at = 0.0  # s, when that detection arrived
         self._velocity = (0.0, 0.0)  # m/s, from the last two delivered detections
         self._look_heading = 0.0
+        self._detoured = False  # the servo last turned away to detour (module docstring)
 
     # -- the strategy
 
@@ -141,7 +153,10 @@ class AnticipatingPursuer(SmartPursuer):
                     0.0, clamp(self.config.k_heading * error, self.context.pursuer.w_max)
                 )
             self._search(observation)  # looked and did not see it: go to the estimate
-        return self._search_or_scan(observation)
+        command = self._search_or_scan(observation)
+        if self.mode != SEARCH:
+            self._detoured = False  # at the estimate (scanning): looking is worth it again
+        return command
 
     # -- tracking
 
@@ -182,15 +197,18 @@ class AnticipatingPursuer(SmartPursuer):
         v = clamp(closing * max(0.0, math.cos(error)), body.v_max)
         reach = math.copysign(max(abs(v) * LOOKAHEAD_TIME, body.radius), v)
         if v != 0.0 and not self._clear(pose, reach):
-            blocked_ahead = v > 0 and self.config.detour
-            return self._detour(observation, w) if blocked_ahead else Velocity(0.0, w)
+            self._detoured = v > 0 and self.config.detour
+            return self._detour(observation, w) if self._detoured else Velocity(0.0, w)
+        self._detoured = False
         return Velocity(v, w)
 
     # -- searching
 
     def _lost(self, observation: PursuerObservation) -> Plan:
         """Look toward the belief mass in line of sight when it is worth a turn, else
-        the smart pursuer's search."""
+        the smart pursuer's search; after a detour, the search (module docstring)."""
+        if self._detoured:
+            return self._search(observation)
         heading, mass = self.best_look(observation)
         off = abs(wrap_angle(heading - observation.pose.theta))
         if mass >= self.config.look_mass and off > 0.25 * self.context.camera.fov:
