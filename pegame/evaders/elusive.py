@@ -95,31 +95,27 @@ class ElusiveEvader(Evader):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(self.horizon > 0, "evader.horizon", "a positive distance in m", self.horizon)
-            require(
-                self.horizon_p > 0, "evader.horizon_p", "a positive distance in m", self.horizon_p
-            )
+            require(self.horizon > 0, "horizon", "a positive distance in m", self.horizon)
+            require(self.horizon_p > 0, "horizon_p", "a positive distance in m", self.horizon_p)
             for key in ("flee_weight", "hide_weight"):
                 value = getattr(self, key)
-                require(value >= 0, f"evader.{key}", "a weight >= 0 (s per s)", value)
+                require(value >= 0, key, "a weight >= 0 (s per s)", value)
             require(
                 self.turn_weight >= 0,
-                "evader.turn_weight",
+                "turn_weight",
                 "a weight >= 0 (s per s)",
                 self.turn_weight,
             )
             require(
                 self.exposed_penalty >= 0,
-                "evader.exposed_penalty",
+                "exposed_penalty",
                 "a cost >= 0 s",
                 self.exposed_penalty,
             )
-            require(
-                self.hide_margin >= 0, "evader.hide_margin", "a distance >= 0 m", self.hide_margin
-            )
+            require(self.hide_margin >= 0, "hide_margin", "a distance >= 0 m", self.hide_margin)
             require(
                 0 < self.sight_angle_step <= 0.1,
-                "evader.sight_angle_step",
+                "sight_angle_step",
                 "an angle in (0, 0.1] rad",
                 self.sight_angle_step,
             )

@@ -94,20 +94,20 @@ class AnticipatingPursuer(SmartPursuer):
             super().__post_init__()
             require(
                 self.k_heading > 0,
-                "pursuer.k_heading",
+                "k_heading",
                 "a positive gain in rad/s per rad",
                 self.k_heading,
             )
-            require(self.lead_time >= 0, "pursuer.lead_time", "a time >= 0 s", self.lead_time)
+            require(self.lead_time >= 0, "lead_time", "a time >= 0 s", self.lead_time)
             require(
                 0 < self.look_mass <= 1,
-                "pursuer.look_mass",
+                "look_mass",
                 "a weight in (0, 1] (1: never look)",
                 self.look_mass,
             )
             require(
                 0 < self.look_angle_step <= 0.1,
-                "pursuer.look_angle_step",
+                "look_angle_step",
                 "an angle in (0, 0.1] rad",
                 self.look_angle_step,
             )
