@@ -1,0 +1,96 @@
+"""Whole-game speed of two pegame checkouts, A/B: the figures of README's "This release".
+
+    python docs/performance/ab_games.py --seeds 12 --reps 4 --maps enclosed,hall,brick \
+        base=/path/to/old/python:/path/to/old/checkout  main=python:.
+
+Each side is NAME=PYTHON:CHECKOUT (the checkout's directory is put first on PYTHONPATH,
+so PYTHON needs pegame's dependencies and, for the entry points, pegame installed from a
+checkout with the same plugin names). One worker process per side plays 90 s games with
+the default (S-S) config and recorder=none; the workers alternate game by game, in a
+rotating order, so that the machine's other load hits both alike. Per (map, seed) the
+best CPU time (``time.process_time``) of ``--reps`` plays is kept; the report gives, per
+map, each side's sum over seeds and its ratio to the first side, and the median of the
+per-seed ratios.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+
+def worker() -> None:
+    """Read 'MAP SEED' lines; answer 'CPU_SECONDS TRACKING_RATE' per game."""
+    from pegame.config import compose
+    from pegame.game import Game
+
+    for env in ("enclosed", "hall"):  # warm up: numba caches, map loads
+        Game(compose(["recorder=none", f"env={env}", "game.seed=999", "game.t_max=5"])).play(".")
+    print("ready", flush=True)
+    for line in sys.stdin:
+        env, seed = line.split()
+        game = Game(compose(["recorder=none", f"env={env}", f"game.seed={seed}"]))
+        start = time.process_time()
+        rate = game.play(".").result["tracking_rate"]
+        print(f"{time.process_time() - start:.6f} {rate}", flush=True)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("sides", nargs="+", help="NAME=PYTHON:CHECKOUT, the first is the reference")
+    parser.add_argument("--seeds", type=int, default=12)
+    parser.add_argument("--reps", type=int, default=4)
+    parser.add_argument("--maps", default="enclosed,hall,brick")
+    args = parser.parse_args()
+    maps = args.maps.split(",")
+    workers = {}
+    for side in args.sides:
+        name, spec = side.split("=", 1)
+        python, checkout = spec.split(":", 1)
+        env = {**os.environ, "PYTHONPATH": os.path.abspath(checkout)}
+        workers[name] = subprocess.Popen(
+            [python, os.path.abspath(__file__), "--worker"],
+            cwd=os.environ.get("TMPDIR", "/tmp"),
+            env=env,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+    for name, process in workers.items():
+        if process.stdout.readline().strip() != "ready":
+            sys.exit(f"worker {name} did not start")
+    names = list(workers)
+    best: dict[str, dict[str, dict[int, float]]] = {n: {m: {} for m in maps} for n in names}
+    for env in maps:
+        for seed in range(args.seeds):
+            for rep in range(args.reps):
+                turn = (seed + rep) % len(names)
+                for name in names[turn:] + names[:turn]:
+                    process = workers[name]
+                    process.stdin.write(f"{env} {seed}\n")
+                    process.stdin.flush()
+                    seconds = float(process.stdout.readline().split()[0])
+                    kept = best[name][env]
+                    kept[seed] = min(kept.get(seed, float("inf")), seconds)
+    for process in workers.values():
+        process.stdin.close()
+    reference = names[0]
+    for env in maps:
+        base = best[reference][env]
+        parts = [env]
+        for name in names:
+            total = sum(best[name][env].values())
+            median = statistics.median(best[name][env][s] / base[s] for s in base)
+            parts.append(
+                f"{name} {total:.3f} s ratio {total / sum(base.values()):.3f} "
+                f"(median per-seed {median:.3f})"
+            )
+        print(" | ".join(parts), flush=True)
+
+
+if __name__ == "__main__":
+    worker() if sys.argv[1:] == ["--worker"] else main()
