@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from collections.abc import Callable
 
 import gymnasium
 import numpy as np
@@ -45,8 +46,9 @@ def evaluate(envs: list[gymnasium.Env], policy: LinearPolicy, seeds: list[int]) 
     return float(np.mean(rates))
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def options(description: str) -> argparse.Namespace:
+    """The trainer's command-line options (shared with ``train_vector_cem.py``)."""
+    parser = argparse.ArgumentParser(description=description.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=5.0, help="wall-time budget")
     parser.add_argument(
         "--generations", type=int, default=None, help="stop after this many (reproducible)"
@@ -67,24 +69,24 @@ def main() -> None:
     parser.add_argument("--crop-resolution", type=float, default=0.5)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", default="cem_pursuer.npz")
-    args = parser.parse_args()
+    return parser.parse_args()
 
-    settings = ObservationSettings(args.crop_cells, args.crop_resolution)
-    envs = [
-        gymnasium.make(
-            "pegame/Pursuit-v0",
-            overrides=[*args.override, f"game.t_max={args.t_max}"],
-            opponent=opponent,
-            crop_cells=settings.crop_cells,
-            crop_resolution=settings.crop_resolution,
-        )
-        for opponent in args.opponents.split(",")
-    ]
-    n_obs = envs[0].observation_space.shape[0]
+
+def train(
+    args: argparse.Namespace,
+    settings: ObservationSettings,
+    n_obs: int,
+    crop: slice,
+    score: Callable[[list[LinearPolicy], list[int]], np.ndarray],
+    held_out: Callable[[LinearPolicy], float],
+) -> None:
+    """The cross-entropy method (module docstring) over linear policies of ``n_obs``
+    observations whose ``crop`` part starts with a smaller spread; ``score(policies,
+    seeds)`` gives each policy's mean tracking rate, ``held_out(policy)`` the final
+    policy's on held-out games. Saves the policy to ``args.out``."""
     rng = np.random.default_rng(args.seed)
     # Start near "do nothing"; the crop's many weights start with a smaller spread than
     # the pose and detection features so that they do not drown the useful signal.
-    crop = envs[0].unwrapped.layout["crop"]
     std = np.full((2, n_obs + 1), 1.0)
     std[:, crop] = 0.03
     mean, std = np.zeros(std.size), std.ravel()
@@ -99,7 +101,7 @@ def main() -> None:
     while time.monotonic() < deadline and generation != args.generations:
         seeds = [int(s) for s in rng.integers(2**31, size=args.episodes)]
         thetas = mean + std * rng.standard_normal((args.population, mean.size))
-        scores = np.array([evaluate(envs, policy_of(theta), seeds) for theta in thetas])
+        scores = score([policy_of(theta) for theta in thetas], seeds)
         elite = thetas[np.argsort(scores)[-n_elite:]]
         # A small floor on the spread keeps the search from collapsing too early.
         mean, std = elite.mean(axis=0), elite.std(axis=0) + 0.02
@@ -110,10 +112,32 @@ def main() -> None:
             flush=True,
         )
     policy_of(mean).save(args.out)
-    held_out = evaluate(envs, policy_of(mean), list(range(1000, 1005)))
     print(
-        f"saved {args.out}: tracking rate {held_out:.3f} over 5 held-out {args.t_max:g} s games "
-        f"against each of the {args.opponents} evaders"
+        f"saved {args.out}: tracking rate {held_out(policy_of(mean)):.3f} over 5 held-out "
+        f"{args.t_max:g} s games against each of the {args.opponents} evaders"
+    )
+
+
+def main() -> None:
+    args = options(__doc__)
+    settings = ObservationSettings(args.crop_cells, args.crop_resolution)
+    envs = [
+        gymnasium.make(
+            "pegame/Pursuit-v0",
+            overrides=[*args.override, f"game.t_max={args.t_max}"],
+            opponent=opponent,
+            crop_cells=settings.crop_cells,
+            crop_resolution=settings.crop_resolution,
+        )
+        for opponent in args.opponents.split(",")
+    ]
+    train(
+        args,
+        settings,
+        envs[0].observation_space.shape[0],
+        envs[0].unwrapped.layout["crop"],
+        lambda policies, seeds: np.array([evaluate(envs, p, seeds) for p in policies]),
+        lambda policy: evaluate(envs, policy, list(range(1000, 1005))),
     )
 
 

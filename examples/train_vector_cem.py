@@ -13,17 +13,15 @@ arguments both scripts train the same policy, bit for bit, this one in less wall
     python examples/train_vector_cem.py --minutes 5 --out cem_pursuer.npz
     python -m pegame pursuer=policy pursuer.path=cem_pursuer.npz evader=smart
 
-The options are train_cem.py's (see there). The opponents are Python strategies playing
+The options and the CEM loop are train_cem.py's (imported from it). The opponents are Python strategies playing
 game by game (:mod:`pegame.vector.opponents`), so what the batch saves is the pursuer's
 side of every step: the simulator, the detector, the observation.
 """
 
 from __future__ import annotations
 
-import argparse
-import time
-
 import numpy as np
+from train_cem import options, train  # the options and the CEM loop, shared
 
 from pegame.envs import vector_env
 from pegame.envs.observations import ObservationSettings
@@ -53,29 +51,7 @@ def evaluate(envs: dict, policies: list[LinearPolicy], seeds: list[int]) -> np.n
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--minutes", type=float, default=5.0, help="wall-time budget")
-    parser.add_argument(
-        "--generations", type=int, default=None, help="stop after this many (reproducible)"
-    )
-    parser.add_argument("--population", type=int, default=16, help="candidates per generation")
-    parser.add_argument(
-        "--elite", type=float, default=0.25, help="fraction of candidates refitted on"
-    )
-    parser.add_argument("--episodes", type=int, default=2, help="games per candidate and opponent")
-    parser.add_argument("--t-max", type=float, default=30.0, help="game length in training (s)")
-    parser.add_argument(
-        "--opponents", default="random,smart", help="the evader strategies trained against"
-    )
-    parser.add_argument(
-        "--override", action="append", default=["env=enclosed"], help="an app override"
-    )
-    parser.add_argument("--crop-cells", type=int, default=8)
-    parser.add_argument("--crop-resolution", type=float, default=0.5)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", default="cem_pursuer.npz")
-    args = parser.parse_args()
-
+    args = options(__doc__)
     settings = ObservationSettings(args.crop_cells, args.crop_resolution)
 
     def envs_of(num_envs: int) -> dict:
@@ -92,37 +68,13 @@ def main() -> None:
 
     envs = envs_of(args.population * args.episodes)
     first = next(iter(envs.values()))
-    n_obs = first.single_observation_space.shape[0]
-    rng = np.random.default_rng(args.seed)
-    # As train_cem.py: start near "do nothing", the crop's weights with a smaller spread.
-    std = np.full((2, n_obs + 1), 1.0)
-    std[:, first.layout["crop"]] = 0.03
-    mean, std = np.zeros(std.size), std.ravel()
-    n_elite = max(2, int(round(args.elite * args.population)))
-
-    def policy_of(theta: np.ndarray) -> LinearPolicy:
-        rows = theta.reshape(2, n_obs + 1)
-        return LinearPolicy(rows[:, :-1], rows[:, -1], "pursuer", settings)
-
-    deadline = time.monotonic() + 60.0 * args.minutes
-    generation = 0
-    while time.monotonic() < deadline and generation != args.generations:
-        seeds = [int(s) for s in rng.integers(2**31, size=args.episodes)]
-        thetas = mean + std * rng.standard_normal((args.population, mean.size))
-        scores = evaluate(envs, [policy_of(theta) for theta in thetas], seeds)
-        elite = thetas[np.argsort(scores)[-n_elite:]]
-        mean, std = elite.mean(axis=0), elite.std(axis=0) + 0.02
-        generation += 1
-        print(
-            f"generation {generation}: best {scores.max():.3f}, mean {scores.mean():.3f}, "
-            f"elite mean {np.sort(scores)[-n_elite:].mean():.3f}",
-            flush=True,
-        )
-    policy_of(mean).save(args.out)
-    held_out = evaluate(envs_of(5), [policy_of(mean)], list(range(1000, 1005)))[0]
-    print(
-        f"saved {args.out}: tracking rate {held_out:.3f} over 5 held-out {args.t_max:g} s games "
-        f"against each of the {args.opponents} evaders"
+    train(
+        args,
+        settings,
+        first.single_observation_space.shape[0],
+        first.layout["crop"],
+        lambda policies, seeds: evaluate(envs, policies, seeds),
+        lambda policy: evaluate(envs_of(5), [policy], list(range(1000, 1005)))[0],
     )
 
 

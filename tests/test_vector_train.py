@@ -17,6 +17,9 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 def run_example(name: str, monkeypatch, *args: str) -> None:
+    """Run examples/<name>.py's main() with ``args``, its folder on sys.path as when the
+    script is run (train_vector_cem.py imports train_cem.py)."""
+    monkeypatch.syspath_prepend(str(EXAMPLES))
     spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
