@@ -35,7 +35,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from pegame.report.load import load_sweep
-from pegame.report.paired import by_seed, paired_test
+from pegame.report.paired import KEYS, by_seed, paired_test
 from pegame.report.statistics import ALPHA, describe, holm
 
 CONDITIONS = ("default", "paper_conditions")
@@ -299,27 +299,8 @@ def goal_tests(cells: dict) -> list[dict]:
 
 
 def write_goals(rows: list[dict], out: Path) -> None:
-    keys = [
-        "goal",
-        "conditions",
-        "x",
-        "y",
-        "alternative",
-        "map",
-        "speed_ratio",
-        "n_pairs",
-        "mean_x",
-        "mean_y",
-        "mean_difference",
-        "ci_low",
-        "ci_high",
-        "zero_differences",
-        "W",
-        "p",
-        "p_holm",
-        "rank_biserial",
-        "met",
-    ]
+    keys = ["goal", "conditions", "x", "y", "alternative", "map", "speed_ratio", *KEYS]
+    keys += ["p_holm", "met"]
     with (out / "goals.csv").open("w", newline="") as f:
         writer = csv.DictWriter(f, keys, extrasaction="ignore")
         writer.writeheader()
