@@ -65,19 +65,25 @@ def _sample_cells(frame, height, width, ax, ay, dx, dy, count, start, size, cell
     the segment into ``cells`` by :func:`pegame.vector.exact.cell_by_product`; returns
     whether all are decided. Inlined with ``rotated`` a constant (no branch in the loop).
     """
-    ox, oy, gc, gs = frame[0], frame[1], frame[2], frame[3]
-    inverse, dt = 1.0 / frame[5], 1.0 / count
+    inverse = 1.0 / frame[5]
     decided = True
     for j in range(size):
-        k = start + j
-        t = 1.0 if k == count else k * dt
-        u = ax + t * dx - ox
-        v = ay + t * dy - oy
-        if rotated:
-            u, v = gc * u + gs * v, -gs * u + gc * v
+        u, v = _sample_point(frame, ax, ay, dx, dy, start + j, count, rotated)
         cells[j], ok = cell_by_product(u, v, inverse, height, width)
         decided &= ok
     return decided
+
+
+@njit(cache=True, inline="always")
+def _sample_point(frame, ax, ay, dx, dy, k, count, rotated):
+    """Grid-frame point (u, v) (m) of sample k of count along the segment from (ax, ay)
+    by (dx, dy), as :func:`pegame.visibility.sight._segment_clear` places it."""
+    t = 1.0 if k == count else k * (1.0 / count)
+    u = ax + t * dx - frame[0]
+    v = ay + t * dy - frame[1]
+    if rotated:
+        u, v = frame[2] * u + frame[3] * v, -frame[3] * u + frame[2] * v
+    return u, v
 
 
 @njit(cache=True)
@@ -92,10 +98,9 @@ def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
     world.blocked. (The functions here take the world's arrays, not the World: an
     inlined function given a NamedTuple pays a reference count per array.)"""
     height, width = blocked.shape
-    ox, oy, gc, gs, rotated, res = frame[0], frame[1], frame[2], frame[3], frame[4] != 0.0, frame[5]
+    rotated = frame[4] != 0.0
     count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
     dx, dy = bx - ax, by - ay
-    dt = 1.0 / count
     cells = np.empty(_CHUNK, np.int64)
     for start in range(0, count + 1, _CHUNK):
         size = min(_CHUNK, count + 1 - start)
@@ -109,13 +114,8 @@ def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
             )
         if not decided:
             for j in range(size):
-                k = start + j
-                t = 1.0 if k == count else k * dt
-                u = ax + t * dx - ox
-                v = ay + t * dy - oy
-                if rotated:
-                    u, v = gc * u + gs * v, -gs * u + gc * v
-                cells[j] = cell_by_division(u, v, res, height, width)
+                u, v = _sample_point(frame, ax, ay, dx, dy, start + j, count, rotated)
+                cells[j] = cell_by_division(u, v, frame[5], height, width)
         for j in range(size):
             if values[cells[j]]:
                 return False
