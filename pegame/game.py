@@ -453,7 +453,7 @@ class Game:
             trajectory: list[tuple] = []
             row = trajectory_row if self.team is None else team_trajectory_row
             try:
-                while not loop.done:
+                for _ in range(loop.ticks - loop.step):
                     trajectory.append(row(loop.advance()))
                 result = self._result(loop.metrics)
             except BaseException as error:

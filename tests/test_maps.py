@@ -18,6 +18,7 @@ from scipy import ndimage
 
 from pegame.errors import MapError
 from pegame.grid import OccupancyGrid, load_map, per_grid, save_map
+from pegame.grid.cells import cell_centres
 
 MAPS_DIR = Path(__file__).resolve().parents[1] / "maps"
 
@@ -449,3 +450,11 @@ def test_per_grid_cache_lives_and_dies_with_its_grid():
     del grid, held
     gc.collect()
     assert alive() is None
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.7, -2.9])
+def test_cell_centres_are_cell_to_world_bit_for_bit(yaw):
+    grid = OccupancyGrid(np.zeros((37, 53), dtype=np.int8), 0.05, (1.3, -2.1, yaw))
+    cells = np.arange(37 * 53)
+    expected = np.stack(grid.cell_to_world(*np.divmod(cells, 53)), axis=-1)
+    assert np.array_equal(cell_centres(cells, grid.width, grid.kernel_frame), expected)

@@ -63,6 +63,8 @@ class OracleDetector(Detector):
         self.perception.reset()
 
     def detect(self, frame: SensorFrame) -> Detection | None:
+        if self.perception.passthrough:  # each frame's own capture (no closure to build)
+            return self._capture(frame)
         return self.perception.deliver(frame.time, frame.camera_pose, lambda: self._capture(frame))
 
     def _capture(self, frame: SensorFrame) -> Detection | None:
@@ -73,7 +75,7 @@ class OracleDetector(Detector):
         if evader is None or not in_view(self.context.grid, camera, cam, (evader.x, evader.y)):
             return None
         distance = cam.distance_to(evader)
-        if not perception.in_range(distance):
+        if distance > perception.range:  # out of the detection range
             return None
         # Draw both numbers every time so the random stream does not depend on outcomes.
         miss, noise = self.rng.random(), self.rng.normal(0.0, 1.0)

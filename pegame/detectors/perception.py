@@ -209,6 +209,10 @@ class Perception:
         self.range = detection_range(config, context.camera)
         self.rngs = dict(zip(PARTS, rng.spawn(len(PARTS))))
         self.period = context.control_dt if config.rate is None else 1.0 / config.rate
+        # Whether the range or the occlusion miss is on.
+        self.misses_by_range_or_occlusion = (
+            config.miss_range_start is not None or config.occlusion_miss > 0
+        )
         # Every pipeline part off: each tick delivers its own capture, nothing to hold.
         self.passthrough = (
             config.rate is None
@@ -320,11 +324,6 @@ class Perception:
             ramp = (distance - cfg.miss_range_start) / (self.range - cfg.miss_range_start)
             p_range = cfg.miss_at_range * min(1.0, max(0.0, ramp))
         return 1.0 - (1.0 - p_range) * (1.0 - cfg.occlusion_miss * hidden)
-
-    @property
-    def misses_by_range_or_occlusion(self) -> bool:
-        """Whether the range or the occlusion miss is on."""
-        return self.config.miss_range_start is not None or self.config.occlusion_miss > 0
 
     def missed_by_range(self, distance: float, hidden: float = 0.0) -> bool:
         """Draw the range and occlusion miss (no draw when both are off)."""

@@ -48,6 +48,7 @@ from numba import njit
 from scipy.ndimage import distance_transform_edt
 
 from pegame.grid import OccupancyGrid, per_grid
+from pegame.grid.cells import cell_centres
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.navigation import Planner
 from pegame.types import Camera, Pose
@@ -450,8 +451,9 @@ class EscapeSearch:
     def centres(self, cells) -> np.ndarray:
         """Float (..., 2): the map-frame centres (m) of flat row-major cell indices (an
         index or an array of them), as :meth:`OccupancyGrid.cell_to_world` gives them."""
-        rows, cols = np.divmod(np.asarray(cells, dtype=np.int64), self.grid.width)
-        return np.stack(self.grid.cell_to_world(rows, cols), axis=-1)
+        cells = np.asarray(cells, dtype=np.int64)
+        grid = self.grid
+        return cell_centres(cells.ravel(), grid.width, grid.kernel_frame).reshape(*cells.shape, 2)
 
     def _component_at(self, me: Pose) -> _Component:
         """The candidate cells of the evader's connected component: the one last used when

@@ -5,7 +5,8 @@
 - :mod:`pegame.grid.ros`: :func:`load_map` and :func:`save_map` of ROS map_server YAML and
   image files;
 - :mod:`pegame.grid.cells`: :func:`point_cell` and :func:`cell_blocked`, the numba helpers
-  every grid kernel uses to find and test the cell of a map point;
+  every grid kernel uses to find and test the cell of a map point, and
+  :func:`pegame.grid.cells.cell_centres` of many cells at once;
 - :mod:`pegame.grid.cache`: :func:`per_grid`, the one cache of objects derived from a grid,
   and :func:`read_only` for the arrays it shares.
 

@@ -1,4 +1,5 @@
-"""Numba helpers that find the cell of a map point and test it, for every grid kernel.
+"""Numba helpers that find the cell of a map point and test it, for every grid kernel,
+and the centres of many cells at once.
 
 They take a grid's map-to-cell transform as its :class:`pegame.grid.GridFrame`
 (``OccupancyGrid.frame``) and reproduce :meth:`OccupancyGrid.world_to_cell` operation for
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
@@ -32,3 +34,24 @@ def cell_blocked(blocked, row, col):
     """True when (row, col) is off the grid or True in the bool (H, W) mask ``blocked``."""
     height, width = blocked.shape
     return row < 0 or row >= height or col < 0 or col >= width or blocked[row, col]
+
+
+@njit(cache=True)
+def cell_centres(cells, width, frame):
+    """Float (N, 2): the map-frame centres (x, y) (m) of the flat row-major indices
+    ``cells`` (int (N,), row * ``width`` + col), by the operations of
+    :meth:`OccupancyGrid.cell_to_world` in its order (the same floats), in one pass instead
+    of its several numpy passes."""
+    out = np.empty((cells.size, 2))
+    resolution = frame[RESOLUTION]
+    for k in range(cells.size):
+        row = cells[k] // width
+        col = cells[k] - row * width
+        u = (col + 0.5) * resolution
+        v = (row + 0.5) * resolution
+        if frame[ROTATED]:
+            c, s = frame[COS_YAW], frame[SIN_YAW]
+            u, v = c * u - s * v, s * u + c * v
+        out[k, 0] = u + frame[OX]
+        out[k, 1] = v + frame[OY]
+    return out

@@ -66,9 +66,7 @@ class OccupancyGrid:
     name: str = "map"
     blocked: np.ndarray = field(init=False, repr=False)
     frame: GridFrame = field(init=False, repr=False)
-    kernel_frame: tuple = field(
-        init=False, repr=False
-    )  # the frame as kernels take it  # the map-to-cell transform for kernels
+    kernel_frame: tuple = field(init=False, repr=False)  # the frame as kernels take it
 
     def __post_init__(self) -> None:
         data = np.ascontiguousarray(self.data, dtype=np.int8)
