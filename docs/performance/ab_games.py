@@ -10,7 +10,8 @@ the default (S-S) config and recorder=none; the workers alternate game by game, 
 rotating order, so that the machine's other load hits both alike. Per (map, seed) the
 best CPU time (``time.process_time``) of ``--reps`` plays is kept; the report gives, per
 map, each side's sum over seeds and its ratio to the first side, and the median of the
-per-seed ratios.
+per-seed ratios. The sides must play the same games: seeds whose tracking rates differ
+are reported. ``--csv PATH`` writes every play.
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=12)
     parser.add_argument("--reps", type=int, default=4)
     parser.add_argument("--maps", default="enclosed,hall,brick")
+    parser.add_argument("--csv", help="also write every game's map, seed, side, rep, seconds")
     args = parser.parse_args()
     maps = args.maps.split(",")
     workers = {}
@@ -65,6 +67,7 @@ def main() -> None:
             sys.exit(f"worker {name} did not start")
     names = list(workers)
     best: dict[str, dict[str, dict[int, float]]] = {n: {m: {} for m in maps} for n in names}
+    rows = []
     for env in maps:
         for seed in range(args.seeds):
             for rep in range(args.reps):
@@ -73,11 +76,21 @@ def main() -> None:
                     process = workers[name]
                     process.stdin.write(f"{env} {seed}\n")
                     process.stdin.flush()
-                    seconds = float(process.stdout.readline().split()[0])
+                    seconds, rate = process.stdout.readline().split()
+                    seconds = float(seconds)
+                    rows.append((env, seed, name, rep, seconds, rate))
                     kept = best[name][env]
                     kept[seed] = min(kept.get(seed, float("inf")), seconds)
     for process in workers.values():
         process.stdin.close()
+    rates = {(env, seed, name): rate for env, seed, name, _, _, rate in rows}
+    differ = sorted({(e, s) for e, s, n in rates if rates[(e, s, n)] != rates[(e, s, names[0])]})
+    if differ:
+        print(f"the sides played different games (tracking rates differ): {differ}", flush=True)
+    if args.csv:
+        with open(args.csv, "w", encoding="utf-8") as out:
+            out.write("map,seed,side,rep,cpu_seconds,tracking_rate\n")
+            out.writelines(",".join(map(str, row)) + "\n" for row in rows)
     reference = names[0]
     for env in maps:
         base = best[reference][env]
