@@ -43,12 +43,14 @@ def worker() -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("sides", nargs="+", help="NAME=PYTHON:CHECKOUT, the first is the reference")
-    parser.add_argument("--seeds", type=int, default=12)
+    parser.add_argument("--seeds", type=int, default=12, help="play seeds 0 to SEEDS - 1")
+    parser.add_argument("--seed-list", help="comma-separated seeds to play instead of --seeds")
     parser.add_argument("--reps", type=int, default=4)
     parser.add_argument("--maps", default="enclosed,hall,brick")
     parser.add_argument("--csv", help="also write every game's map, seed, side, rep, seconds")
     args = parser.parse_args()
     maps = args.maps.split(",")
+    seeds = [int(s) for s in args.seed_list.split(",")] if args.seed_list else range(args.seeds)
     workers = {}
     for side in args.sides:
         name, spec = side.split("=", 1)
@@ -69,7 +71,7 @@ def main() -> None:
     best: dict[str, dict[str, dict[int, float]]] = {n: {m: {} for m in maps} for n in names}
     rows = []
     for env in maps:
-        for seed in range(args.seeds):
+        for seed in seeds:
             for rep in range(args.reps):
                 turn = (seed + rep) % len(names)
                 for name in names[turn:] + names[:turn]:
