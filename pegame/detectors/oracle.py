@@ -75,7 +75,7 @@ class OracleDetector(Detector):
         if evader is None or not in_view(self.context.grid, camera, cam, (evader.x, evader.y)):
             return None
         distance = cam.distance_to(evader)
-        if distance > perception.range:  # out of the detection range
+        if not perception.in_range(distance):
             return None
         # Draw both numbers every time so the random stream does not depend on outcomes.
         miss, noise = self.rng.random(), self.rng.normal(0.0, 1.0)
