@@ -46,8 +46,9 @@ estimator and the region can be skipped (``estimate=False``: they are the most e
 part of a tick); the belief is then empty and the game has no estimation error.
 
 :class:`pegame.game.Game` (the CLI and sweeps) and the Gymnasium/PettingZoo environments
-(:mod:`pegame.envs`) both drive this loop. A 1v1 game of two strategies moving together
-plays the same tick in a form without the team's per-member lists (:meth:`TickLoop._advance_1v1`).
+(:mod:`pegame.envs`) both drive this loop. A 1v1 game moving together (two strategies, or
+an environment's learners) plays the same tick in a form without the team's per-member
+lists (:meth:`TickLoop._advance_1v1`).
 """
 
 from __future__ import annotations
@@ -157,9 +158,10 @@ class TickLoop:
         self.evader_first = turn_order == "evader_first"
         self.pursuer_plans = [Plan()] * self.n_pursuers
         self.evader_plans = [Plan()] * self.n_evaders
-        # The most played game, one strategy pursuer against one strategy evader moving
-        # together, takes the fast form of a tick (:meth:`_advance_1v1`).
-        self.one_on_one = self.solo and not self.external and not self.evader_first
+        # The most played game, one pursuer against one evader moving together (a game of
+        # two strategies, or an environment's), takes the fast form of a tick
+        # (:meth:`_advance_1v1`).
+        self.one_on_one = self.solo and not self.evader_first
 
     @property
     def done(self) -> bool:
@@ -324,8 +326,8 @@ class TickLoop:
         tick. Returns the tick that was played."""
         if self.step >= self.ticks:
             raise RuntimeError("The game is over: every tick has been played.")
-        if self.one_on_one and not commands:
-            return self._advance_1v1()
+        if self.one_on_one:
+            return self._advance_1v1(commands)
         commanded = self._commanded(commands) if commands or self.external else {}
         deciding = self.step % self.decide_every == 0
         evaders, pursuers = self.evader_strategies, self.pursuer_strategies
@@ -419,22 +421,32 @@ class TickLoop:
             self._sense()  # also after the last tick: the environments observe the final state
         return tick
 
-    def _advance_1v1(self) -> Tick:
-        """:meth:`advance` for one strategy pursuer against one strategy evader moving
-        together: the same tick in the same order, without the per-member lists and
-        comprehensions of a team's tick, which cost 3-4% of a whole 1v1 game (README,
-        Performance; the most played tick: Game.play and sweeps). ``tests/test_loop.py`` plays built-in
-        pairings both ways and requires the same ticks; set ``one_on_one`` False to take
-        the general form."""
+    def _advance_1v1(self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None) -> Tick:
+        """:meth:`advance` for one pursuer against one evader moving together: the same
+        tick in the same order, without the per-member lists and comprehensions of a
+        team's tick, which cost 3-4% of a whole 1v1 game of two strategies (README,
+        Performance; the most played ticks: Game.play, sweeps and the environments).
+        ``tests/test_loop.py`` plays built-in pairings, and external roles, both ways and
+        requires the same ticks; set ``one_on_one`` False to take the general form."""
         time, pursuer, evader = self.time, self.pursuers[0], self.evaders[0]
         detection, belief, region = self.detections[0][0], self.beliefs[0], self.regions[0]
-        e_obs = EvaderObservation(time, evader, pursuer, region, self.pursuers, 0)
-        p_obs = PursuerObservation(time, pursuer, detection, belief, region, None)
         pursuer_strategy, evader_strategy = self.pursuer_strategies[0], self.evader_strategies[0]
+        e_obs = p_obs = None
+        if "evader" not in self.external:
+            e_obs = EvaderObservation(time, evader, pursuer, region, self.pursuers, 0)
+        if "pursuer" not in self.external:
+            p_obs = PursuerObservation(time, pursuer, detection, belief, region, None)
         if self.step % self.decide_every == 0:  # the evader first, then the pursuer (paper)
-            self.evader_plans = [evader_strategy.decide(e_obs)]
-            self.pursuer_plans = [pursuer_strategy.decide(p_obs)]
-        p_cmd, e_cmd = pursuer_strategy.control(p_obs), evader_strategy.control(e_obs)
+            if e_obs is not None:
+                self.evader_plans = [evader_strategy.decide(e_obs)]
+            if p_obs is not None:
+                self.pursuer_plans = [pursuer_strategy.decide(p_obs)]
+        if self.external:
+            p_cmd, e_cmd = self._external_1v1(commands)
+        if p_obs is not None:
+            p_cmd = pursuer_strategy.control(p_obs)
+        if e_obs is not None:
+            e_cmd = evader_strategy.control(e_obs)
         in_view = self.in_views[0][0]
         self.metrics.add(pursuer, evader, detection is not None, in_view, belief)
         tick = Tick(
@@ -452,10 +464,29 @@ class TickLoop:
             None,
         )
         self.recorder.log(tick)
-        self._integrate((p_cmd,), (e_cmd,))
+        dt = self.context.control_dt / self.substeps
+        for _ in range(self.substeps):
+            self.sim.step(p_cmd, e_cmd, dt)
         self._next_tick()
-        self._sense()
+        self._sense_one(None)
         return tick
+
+    def _external_1v1(
+        self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None
+    ) -> tuple[Velocity | None, Velocity | None]:
+        """The (pursuer, evader) commands of the external roles of a 1v1 game (None for a
+        role its strategy commands), as :meth:`_commanded` reads them."""
+        commands = commands or {}
+        pursuer, evader = commands.get("pursuer"), commands.get("evader")
+        if ("pursuer" in self.external and pursuer is None) or (
+            "evader" in self.external and evader is None
+        ):
+            self._commanded(commands)  # raises, naming the missing roles
+        if pursuer is not None and not isinstance(pursuer, Velocity):
+            pursuer = pursuer[0]
+        if evader is not None and not isinstance(evader, Velocity):
+            evader = evader[0]
+        return pursuer, evader
 
     def _next_tick(self) -> None:
         self.step += 1
@@ -466,13 +497,13 @@ class TickLoop:
     ) -> dict[str, list[Velocity]]:
         """The external roles' commands as one list of velocities per role; ValueError
         when an external role has none."""
-        commanded = {
-            role: [command] if isinstance(command, Velocity) else list(command)
-            for role, command in (commands or {}).items()
-        }
-        missing = [role for role in self.external if role not in commanded]
-        if missing:
-            raise ValueError(f"No command for the external role(s) {missing}.")
+        commanded = {}
+        for role, command in (commands or {}).items():  # loops, not comprehensions: per tick
+            commanded[role] = [command] if isinstance(command, Velocity) else list(command)
+        for role in self.external:
+            if role not in commanded:
+                missing = [role for role in self.external if role not in commanded]
+                raise ValueError(f"No command for the external role(s) {missing}.")
         return commanded
 
     def _integrate(

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from pegame.config import compose
 from pegame.game import Game
+from pegame.types import Velocity
 
 PAIRINGS = [
     ("smart", "smart", "enclosed"),
@@ -60,8 +62,39 @@ def test_the_fast_1v1_tick_plays_the_general_tick_over_substeps_and_slow_decisio
     assert fast == general
 
 
-def test_external_roles_and_turns_take_the_general_tick():
-    game = Game(compose(["recorder=none", "game.t_max=2"]))
-    assert not game.start(external=("pursuer",)).one_on_one
+@pytest.mark.parametrize("external", [("pursuer",), ("evader",), ("pursuer", "evader")])
+def test_the_fast_1v1_tick_plays_external_roles_as_the_general_tick(external):
+    def play(one_on_one: bool) -> list:
+        game = Game(compose(["recorder=none", "game.t_max=6", "game.seed=2", "env=hall"]))
+        loop = game.start(external=external)
+        assert loop.one_on_one
+        loop.one_on_one = one_on_one
+        rng = np.random.default_rng(0)
+        ticks = []
+        while not loop.done:
+            commands = {
+                role: Velocity(float(rng.uniform(0.0, 0.5)), float(rng.uniform(-1.0, 1.0)))
+                for role in external
+            }
+            tick = loop.advance(commands)
+            ticks.append((tick.pursuer, tick.evader, tick.detection, tick.commands, tick.in_view))
+        return ticks
+
+    fast = play(True)
+    assert fast == play(False)
+    assert len(fast) == 60
+
+
+def test_a_missing_external_command_is_refused_by_both_forms():
+    for one_on_one in (True, False):
+        loop = Game(compose(["recorder=none", "game.t_max=2"])).start(external=("evader",))
+        loop.one_on_one = one_on_one
+        with pytest.raises(ValueError, match="No command for the external role"):
+            loop.advance({"pursuer": Velocity(0.1, 0.0)})
+
+
+def test_turns_and_teams_take_the_general_tick():
     turns = Game(compose(["recorder=none", "game.t_max=2", "game.turn_order=evader_first"]))
     assert not turns.start().one_on_one
+    team = Game(compose(["recorder=none", "game.t_max=2", "team.pursuers=2"]))
+    assert not team.start().one_on_one

@@ -10,7 +10,8 @@ the default (S-S) config and recorder=none; the workers alternate game by game, 
 rotating order, so that the machine's other load hits both alike. Per (map, seed) the
 best CPU time (``time.process_time``) of ``--reps`` plays is kept; the report gives, per
 map, each side's sum over seeds and its ratio to the first side, and the median of the
-per-seed ratios. The sides must play the same games: seeds whose tracking rates differ
+per-seed ratios. ``--env`` times PettingZoo episodes (both agents learners, uniformly random
+actions, 900 steps) instead of games. The sides must play the same games: seeds whose tracking rates differ
 are reported. ``--csv PATH`` writes every play.
 """
 
@@ -40,6 +41,34 @@ def worker() -> None:
         print(f"{time.process_time() - start:.6f} {rate}", flush=True)
 
 
+def env_worker() -> None:
+    """Read 'MAP SEED' lines; answer 'CPU_SECONDS TRACKING_RATE' per PettingZoo episode:
+    both agents learners with uniformly random actions (the bench's env_steps_per_s)."""
+    import numpy as np
+
+    from pegame.envs.parallel import parallel_env
+
+    envs = {m: parallel_env(overrides=(f"env={m}",)) for m in ("enclosed", "hall", "brick")}
+
+    def episode(env, seed: int) -> float:
+        env.reset(seed=seed)
+        actions = np.random.default_rng(seed).uniform(-1.0, 1.0, (900, 2, 2)).astype(np.float32)
+        for pair in actions:
+            _, _, _, _, infos = env.step({"pursuer": pair[0], "evader": pair[1]})
+            if not env.agents:
+                break
+        return infos["pursuer"]["tracking_rate"]
+
+    for env in envs.values():  # warm up
+        episode(env, 999)
+    print("ready", flush=True)
+    for line in sys.stdin:
+        env, seed = line.split()
+        start = time.process_time()
+        rate = episode(envs[env], int(seed))
+        print(f"{time.process_time() - start:.6f} {rate}", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("sides", nargs="+", help="NAME=PYTHON:CHECKOUT, the first is the reference")
@@ -48,6 +77,9 @@ def main() -> None:
     parser.add_argument("--reps", type=int, default=4)
     parser.add_argument("--maps", default="enclosed,hall,brick")
     parser.add_argument("--csv", help="also write every game's map, seed, side, rep, seconds")
+    parser.add_argument(
+        "--env", action="store_true", help="time PettingZoo episodes of random actions instead"
+    )
     args = parser.parse_args()
     maps = args.maps.split(",")
     seeds = [int(s) for s in args.seed_list.split(",")] if args.seed_list else range(args.seeds)
@@ -57,7 +89,7 @@ def main() -> None:
         python, checkout = spec.split(":", 1)
         env = {**os.environ, "PYTHONPATH": os.path.abspath(checkout)}
         workers[name] = subprocess.Popen(
-            [python, os.path.abspath(__file__), "--worker"],
+            [python, os.path.abspath(__file__), "--env-worker" if args.env else "--worker"],
             cwd=os.environ.get("TMPDIR", "/tmp"),
             env=env,
             stdin=subprocess.PIPE,
@@ -108,4 +140,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    worker() if sys.argv[1:] == ["--worker"] else main()
+    if sys.argv[1:] == ["--worker"]:
+        worker()
+    elif sys.argv[1:] == ["--env-worker"]:
+        env_worker()
+    else:
+        main()

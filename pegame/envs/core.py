@@ -119,8 +119,11 @@ class EnvGame:
         detections = [0] * len(self.evader_detections)
         for _ in range(self.ticks_per_action):
             loop.advance(commands)
-            for j in range(len(detections)):
-                detections[j] += any(row[j] is not None for row in loop.detections)
+            for j in range(len(detections)):  # loops, not generators: once per tick
+                for row in loop.detections:
+                    if row[j] is not None:
+                        detections[j] += 1
+                        break
             self._remember()
             if loop.done:
                 break
@@ -164,15 +167,13 @@ class EnvGame:
                 f"actions must have exactly the agents {self.agents}; "
                 f"missing {missing}, unexpected {unknown}."
             )
-        return {
-            role: [
-                to_velocity(
-                    actions[agent], self.bodies[role], self.settings.clip_actions, f"{agent} action"
-                )
-                for agent in self.members[role]
-            ]
-            for role in self.roles
-        }
+        commands = {}
+        for role in self.roles:  # loops, not comprehensions: once per step
+            body, clip = self.bodies[role], self.settings.clip_actions
+            commands[role] = velocities = []
+            for agent in self.members[role]:
+                velocities.append(to_velocity(actions[agent], body, clip, f"{agent} action"))
+        return commands
 
     def close(self) -> None:
         """Release the current game's simulator."""
