@@ -37,7 +37,7 @@ from pegame.api import INTERFACES, Context, Tick
 from pegame.config import EnvConfig, GameConfig, TeamConfig, resolve_map_path, team_members, typed
 from pegame.errors import ConfigError, SpawnError
 from pegame.files import write_atomic
-from pegame.grid import OccupancyGrid, load_map
+from pegame.grid import OccupancyGrid, load_map, per_grid, read_only
 from pegame.loop import TickLoop, check_team
 from pegame.metrics import TeamMetrics, TrackingMetrics
 from pegame.navigation import Planner
@@ -87,9 +87,8 @@ def spawn(context: Context, rng: np.random.Generator, attempts: int = 500) -> tu
     """
     grid, camera = context.grid, context.camera
     apart = context.pursuer.radius + context.evader.radius
-    pursuer_space = Planner.shared(grid, context.pursuer.radius).traversable
     evader_space = Planner.shared(grid, context.evader.radius).traversable
-    rows, cols = np.nonzero(pursuer_space)
+    rows, cols = traversable_cells(grid, context.pursuer.radius)
     for _ in range(attempts if rows.size else 0):
         k = int(rng.integers(rows.size))
         x, y = grid.cell_to_world(rows[k], cols[k])
@@ -106,6 +105,17 @@ def spawn(context: Context, rng: np.random.Generator, attempts: int = 500) -> tu
         f"{context.evader.radius} m) in its view (range {camera.near}-{camera.far} m, FOV "
         f"{camera.fov:.3f} rad). Use a map with more free space, smaller radii or a longer camera range."
     )
+
+
+def traversable_cells(grid: OccupancyGrid, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, cols) of the cells where a body of ``radius`` m can stand (the shared
+    planner's traversable mask), row-major; computed once per grid and radius."""
+
+    def build(grid: OccupancyGrid) -> tuple[np.ndarray, np.ndarray]:
+        rows, cols = np.nonzero(Planner.shared(grid, radius).traversable)
+        return read_only(rows), read_only(cols)
+
+    return per_grid(grid, ("game", "traversable cells", radius), build)
 
 
 def _apart(x: float, y: float, radius: float, placed: list[tuple[Pose, float]]) -> bool:
@@ -131,7 +141,7 @@ def spawn_team(
         return (first[0],), (first[1],)
     grid, camera = context.grid, context.camera
     rp, re = context.pursuer.radius, context.evader.radius
-    pursuer_cells = np.column_stack(np.nonzero(Planner.shared(grid, rp).traversable))
+    pursuer_cells = np.column_stack(traversable_cells(grid, rp))
     evader_space = Planner.shared(grid, re).traversable
     for _ in range(attempts):
         placed = [(first[0], rp), (first[1], re)]
