@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pegame.config import compose
-from pegame.envs.crop import LocalCrop, local_crop_reference
+from pegame.envs.crop import LocalCrop, lattice_crop, local_crop_reference
 from pegame.errors import ConfigError
 from pegame.grid import OccupancyGrid
 from pegame.types import Pose
@@ -272,6 +272,26 @@ def test_crop_kernel_matches_the_reference(yaw):
         for x, y, theta in rng.uniform([-1, -1, -4], [5, 4, 4], (20, 3)):
             expected = local_crop_reference(grid, x, y, theta, cells, resolution)
             assert np.array_equal(crop(x, y, theta).reshape(cells, cells), expected)
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.4])
+def test_crop_on_cell_edges_takes_the_division_and_matches_the_reference(yaw):
+    grid = _room(yaw)
+    crop = LocalCrop(grid, 32, 0.2)
+    ox, oy, _ = grid.origin
+    undecided = 0
+    for i, j, turn in [(20, 10, 0.0), (31, 7, math.pi / 2), (44, 33, -math.pi), (12, 50, 0.0)]:
+        # A cell corner, the crop's axes along the grid's: its samples lie on cell edges.
+        u, v, theta = j * grid.resolution, i * grid.resolution, yaw + turn
+        x = ox + math.cos(yaw) * u - math.sin(yaw) * v
+        y = oy + math.sin(yaw) * u + math.cos(yaw) * v
+        expected = local_crop_reference(grid, x, y, theta, 32, 0.2)
+        assert np.array_equal(crop(x, y, theta).reshape(32, 32), expected)
+        out = np.empty(crop.size, dtype=np.float32)
+        c, s = math.cos(theta), math.sin(theta)
+        args = (crop._table, crop._centres, crop._frame, grid.width, x, y, c, s, out, 0)
+        undecided += not lattice_crop(*args, crop._cells, crop._columns)
+    assert undecided > 0  # these poses exercise the division, not only the lattice
 
 
 def test_crop_is_egocentric_and_sees_thin_walls():

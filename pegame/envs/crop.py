@@ -14,7 +14,10 @@ missed (the window is along the map axes, so at 45 degrees it reaches a little l
 than the rotated crop cell's corners).
 
 Two implementations give identical crops: :func:`local_crop_reference` in plain numpy
-and the numba kernel behind :class:`LocalCrop`, which writes into a caller's buffer.
+and the numba kernels behind :class:`LocalCrop`, which write into a caller's buffer: the
+crop's cells from its lattice (:func:`lattice_crop`, a row term plus a column term per
+cell, whose error bound proves the same cells) and, for a pose whose lattice comes too
+near a cell edge, :func:`_crop`'s division. The batched environments use the same two.
 """
 
 from __future__ import annotations
@@ -93,6 +96,111 @@ def _crop(pooled, off_x, off_y, x, y, c, s, gx, gy, gc, gs, rotate, res, out):
             out[k] = 0.0
 
 
+#: a lattice point within this many cells of a cell edge is not decided by the lattice
+_EDGE = 2.0**-20
+#: |u - floor(u) - 1/2| below which a lattice coordinate u is decided
+_DECIDED = 0.5 - _EDGE
+#: the largest size L (cells, see :func:`_lattice_crop`) for which the lattice decides
+_SIZE_LIMIT = 2.0**21
+
+
+@njit(cache=True, inline="always")
+def lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
+    """The crop's cells from the crop's lattice, into out[at:]; returns whether every
+    cell is decided (else out is to be redone by the division: :func:`_crop`, or the
+    batched env's ``_divided_crop``).
+
+    Crop cell (i, j) lies at the grid-frame point (in cells) P + o_j A + o_i B, with
+    o = ``centres`` (m, the crop's cell centres along one axis), P = R(-yaw) (x - gx, y - gy) / res and A, B = R(-yaw)
+    R(theta) (e_x, e_y) / res the crop's axes; its coordinates are the row term
+    P + o_i B (once per row) plus the column term o_j A (once per game, into
+    ``columns``, float64 (2, crop_cells) scratch): a sum per coordinate and cell instead
+    of the reference's rotation and division.
+
+    Why it picks the reference's cells. Let u = 2**-53 and L = (|x| + |y| + |gx| + |gy|
+    + 4 max|o|) / res, a bound (cells) on every quantity either route forms. A rounding
+    errs by at most u times its quantity, and reaches a final coordinate through sums,
+    products by cos/sin (at most 1) and the scaling to cells, so it moves the coordinate
+    by at most u L (1 + u)^k. Per coordinate the reference (:func:`pegame.envs.crop._crop`)
+    rounds 14 times (5 for each of dx and dy, the grid rotation's 3, the division) and
+    this route 18 times (fl(1 / res) in the three scaled terms, the axes' 3 + 3, the
+    position's 2 + 3, the lattice's two products and two sums), so the two are within
+    34 u L (1 + u)^18 < 2**-26 cells of each other for L <= 2**21 (checked per game). A
+    coordinate q of this route with |q - floor(q) - 1/2| < 1/2 - 2**-20 (q - floor(q)
+    is exact) is more than 2**-20 > 2**-26 from every whole number, so the reference's
+    quotient has the same floor: the same cell. A game with a coordinate that close to a
+    cell edge (under one game in 100 on random poses), with L too large, or whose
+    lattice leaves the table's border is redone by the division.
+
+    The crop's bounding box (its centre P plus the reach of its corners, |A| + |B| times
+    max|o|, and 2 cells for rounding) is checked inside ``table`` (:func:`bordered_table`;
+    ``frame`` the crop's map-to-cell numbers as float64 (gx, gy, cos, sin, rotated, res),
+    ``width`` the map's in cells), the pooled map with a border of blocked cells, so
+    that no cell needs a test against the map's edges; the coordinates' cells are found
+    in one vectorised pass (flat indices into ``cells``) and looked up in a second, a
+    gather that does not vectorise (an unsigned index: no test for negative ones).
+    """
+    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
+    padded_height, padded_width = table.shape
+    pad = (padded_width - width) // 2
+    inverse = 1.0 / res
+    ax, ay = (gc * c + gs * s) * inverse, (gc * s - gs * c) * inverse
+    bx, by = (gs * c - gc * s) * inverse, (gc * c + gs * s) * inverse
+    px, py = x - gx, y - gy
+    u0, v0 = (gc * px + gs * py) * inverse, (gc * py - gs * px) * inverse
+    n = centres.size
+    top = max(abs(centres[0]), abs(centres[n - 1]))
+    reach_u = (abs(ax) + abs(bx)) * top + 2.0
+    reach_v = (abs(ay) + abs(by)) * top + 2.0
+    size = (abs(x) + abs(y) + abs(gx) + abs(gy) + 4.0 * top) * inverse
+    if not (
+        size <= _SIZE_LIMIT
+        and u0 - reach_u > -pad
+        and u0 + reach_u < padded_width - pad
+        and v0 - reach_v > -pad
+        and v0 + reach_v < padded_height - pad
+    ):
+        return False  # also NaN
+    origin, stride = float(pad * padded_width + pad), float(padded_width)
+    for j in range(n):
+        columns[0, j] = centres[j] * ax
+        columns[1, j] = centres[j] * ay
+    bad = False
+    for i in range(n):
+        row_u = u0 + centres[i] * bx
+        row_v = v0 + centres[i] * by
+        for j in range(n):
+            u = row_u + columns[0, j]
+            v = row_v + columns[1, j]
+            col, row = np.floor(u), np.floor(v)
+            bad |= (abs(u - col - 0.5) >= _DECIDED) | (abs(v - row - 0.5) >= _DECIDED)
+            cells[i * n + j] = np.int64(row * stride + col + origin)
+    flat = table.reshape(-1)
+    for k in range(n * n):
+        out[at + k] = flat[np.uint64(cells[k])]
+    return not bad
+
+
+def bordered_table(pooled: np.ndarray, offsets: np.ndarray, resolution: float) -> np.ndarray:
+    """Uint8: ``pooled`` (1 blocked, 0 free) inside a border of blocked cells wider than
+    the crop's reach from any point of the map (its corner's distance, max |offset|
+    times sqrt 2 m, and 3 cells), :func:`lattice_crop`'s look-up table (a quarter of
+    float32's cache lines: the look-up is the crop's larger part)."""
+    pad = math.ceil(math.sqrt(2.0) * np.abs(offsets).max() / resolution) + 3
+    return np.pad(pooled.astype(np.uint8), pad, constant_values=1)
+
+
+@njit(cache=True)
+def _crop_fast(table, centres, frame, width, pooled, off_x, off_y, x, y, c, s, out, cells, columns):
+    """:func:`_crop`'s cells into ``out``: from the crop's lattice (:func:`lattice_crop`)
+    when it decides every cell, else by :func:`_crop`'s division."""
+    if lattice_crop(table, centres, frame, width, x, y, c, s, out, 0, cells, columns):
+        return
+    rotate = frame[4] != 0.0
+    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
+    _crop(pooled, off_x, off_y, x, y, c, s, gx, gy, gc, gs, rotate, res, out)
+
+
 class LocalCrop:
     """The crop of ``cells`` x ``cells`` at ``resolution`` m on ``grid``, ready to sample
     (the pooled map and the offsets are prepared once)."""
@@ -104,6 +212,12 @@ class LocalCrop:
         self._off_x, self._off_y = crop_offsets(cells, resolution)
         gx, gy, yaw = grid.origin
         self._origin = (gx, gy, math.cos(yaw), math.sin(yaw), yaw != 0.0, float(grid.resolution))
+        # The lattice route's table, axis centres, numbers and scratch (:func:`lattice_crop`).
+        self._table = bordered_table(self._pooled, self._off_x, grid.resolution)
+        self._centres = np.ascontiguousarray(self._off_x[:cells])
+        self._frame = np.array(self._origin, dtype=np.float64)
+        self._cells = np.empty(self.size, dtype=np.int64)
+        self._columns = np.empty((2, cells))
 
     def __call__(
         self, x: float, y: float, theta: float, out: np.ndarray | None = None
@@ -113,7 +227,11 @@ class LocalCrop:
         float32 array of that size, e.g. a slice of an observation vector)."""
         if out is None:
             out = np.empty(self.size, dtype=np.float32)
-        _crop(
+        _crop_fast(
+            self._table,
+            self._centres,
+            self._frame,
+            self._pooled.shape[1],
             self._pooled,
             self._off_x,
             self._off_y,
@@ -121,7 +239,8 @@ class LocalCrop:
             float(y),
             math.cos(theta),
             math.sin(theta),
-            *self._origin,
             out,
+            self._cells,
+            self._columns,
         )
         return out

@@ -12,6 +12,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from pegame.envs.crop import lattice_crop
 from pegame.envs.observations import AGE_SCALE
 from pegame.vector.exact import cell_by_division, hypot, wrap_angle
 from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER
@@ -32,90 +33,6 @@ def _pose_features(extent, x, y, theta, out, at):
     out[at + 1] = _unit((y - y0) * sy - 1.0)
     out[at + 2] = math.cos(theta)
     out[at + 3] = math.sin(theta)
-
-
-#: a lattice point within this many cells of a cell edge is not decided by the lattice
-_EDGE = 2.0**-20
-#: |u - floor(u) - 1/2| below which a lattice coordinate u is decided
-_DECIDED = 0.5 - _EDGE
-#: the largest size L (cells, see :func:`_lattice_crop`) for which the lattice decides
-_SIZE_LIMIT = 2.0**21
-
-
-@njit(cache=True, inline="always")
-def _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
-    """The crop's cells from the crop's lattice, into out[at:]; returns whether every
-    cell is decided (else out is to be redone by :func:`_divided_crop`).
-
-    Crop cell (i, j) lies at the grid-frame point (in cells) P + o_j A + o_i B, with
-    o = world.crop_centres (m), P = R(-yaw) (x - gx, y - gy) / res and A, B = R(-yaw)
-    R(theta) (e_x, e_y) / res the crop's axes; its coordinates are the row term
-    P + o_i B (once per row) plus the column term o_j A (once per game, into
-    ``columns``, float64 (2, crop_cells) scratch): a sum per coordinate and cell instead
-    of the reference's rotation and division.
-
-    Why it picks the reference's cells. Let u = 2**-53 and L = (|x| + |y| + |gx| + |gy|
-    + 4 max|o|) / res, a bound (cells) on every quantity either route forms. A rounding
-    errs by at most u times its quantity, and reaches a final coordinate through sums,
-    products by cos/sin (at most 1) and the scaling to cells, so it moves the coordinate
-    by at most u L (1 + u)^k. Per coordinate the reference (:func:`pegame.envs.crop._crop`)
-    rounds 14 times (5 for each of dx and dy, the grid rotation's 3, the division) and
-    this route 18 times (fl(1 / res) in the three scaled terms, the axes' 3 + 3, the
-    position's 2 + 3, the lattice's two products and two sums), so the two are within
-    34 u L (1 + u)^18 < 2**-26 cells of each other for L <= 2**21 (checked per game). A
-    coordinate q of this route with |q - floor(q) - 1/2| < 1/2 - 2**-20 (q - floor(q)
-    is exact) is more than 2**-20 > 2**-26 from every whole number, so the reference's
-    quotient has the same floor: the same cell. A game with a coordinate that close to a
-    cell edge (under one game in 100 on random poses), with L too large, or whose
-    lattice leaves the table's border is redone by the division.
-
-    The crop's bounding box (its centre P plus the reach of its corners, |A| + |B| times
-    max|o|, and 2 cells for rounding) is checked inside ``table`` = world.crop_table
-    (``frame`` = world.crop_frame, ``width`` the map's in cells), the pooled map
-    with a border of blocked cells, so that no cell needs a test against the map's edges;
-    the coordinates' cells are found in one vectorised pass (flat indices into ``cells``)
-    and looked up in a second, a gather that does not vectorise (an unsigned index: no
-    test for negative ones).
-    """
-    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
-    padded_height, padded_width = table.shape
-    pad = (padded_width - width) // 2
-    inverse = 1.0 / res
-    ax, ay = (gc * c + gs * s) * inverse, (gc * s - gs * c) * inverse
-    bx, by = (gs * c - gc * s) * inverse, (gc * c + gs * s) * inverse
-    px, py = x - gx, y - gy
-    u0, v0 = (gc * px + gs * py) * inverse, (gc * py - gs * px) * inverse
-    n = centres.size
-    top = max(abs(centres[0]), abs(centres[n - 1]))
-    reach_u = (abs(ax) + abs(bx)) * top + 2.0
-    reach_v = (abs(ay) + abs(by)) * top + 2.0
-    size = (abs(x) + abs(y) + abs(gx) + abs(gy) + 4.0 * top) * inverse
-    if not (
-        size <= _SIZE_LIMIT
-        and u0 - reach_u > -pad
-        and u0 + reach_u < padded_width - pad
-        and v0 - reach_v > -pad
-        and v0 + reach_v < padded_height - pad
-    ):
-        return False  # also NaN
-    origin, stride = float(pad * padded_width + pad), float(padded_width)
-    for j in range(n):
-        columns[0, j] = centres[j] * ax
-        columns[1, j] = centres[j] * ay
-    bad = False
-    for i in range(n):
-        row_u = u0 + centres[i] * bx
-        row_v = v0 + centres[i] * by
-        for j in range(n):
-            u = row_u + columns[0, j]
-            v = row_v + columns[1, j]
-            col, row = np.floor(u), np.floor(v)
-            bad |= (abs(u - col - 0.5) >= _DECIDED) | (abs(v - row - 0.5) >= _DECIDED)
-            cells[i * n + j] = np.int64(row * stride + col + origin)
-    flat = table.reshape(-1)
-    for k in range(n * n):
-        out[at + k] = flat[np.uint64(cells[k])]
-    return not bad
 
 
 @njit(cache=True)
@@ -143,7 +60,7 @@ def _divided_crop(world, x, y, c, s, out, at):
 def crop_into(world, x, y, theta, out, at, cells):
     """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
     rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int64
-    scratch of the crop's size): from the crop's lattice (:func:`_lattice_crop`), or by
+    scratch of the crop's size): from the crop's lattice (:func:`pegame.envs.crop.lattice_crop`), or by
     the division when the lattice does not decide every cell (a pose on cell edges), as
     the features' loop finds them. Returns whether the division was needed.
     ``tests/test_vector_kernels.py`` compares the crop with the reference on random poses
@@ -152,7 +69,7 @@ def crop_into(world, x, y, theta, out, at, cells):
     table, centres, frame = world.crop_table, world.crop_centres, world.crop_frame
     columns = np.empty((2, centres.size))
     width = world.pooled.shape[1]
-    if _lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
+    if lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
         return False
     _divided_crop(world, x, y, c, s, out, at)
     return True
@@ -216,7 +133,7 @@ def _features_block(world, rules, state, out, pursuer, block):
             _evader_row(extent, poses, game, row)
         x, y, theta = poses[game, role, 0], poses[game, role, 1], poses[game, role, 2]
         c, s = math.cos(theta), math.sin(theta)
-        if not _lattice_crop(table, centres, frame, width, x, y, c, s, row, at, cells, columns):
+        if not lattice_crop(table, centres, frame, width, x, y, c, s, row, at, cells, columns):
             _divided_crop(world, x, y, c, s, row, at)
 
 

@@ -254,20 +254,11 @@ def _world(grid, context, settings: EnvSettings) -> World:
         crop._off_x,
         crop._off_y,
         np.array(crop._origin, dtype=np.float64),
-        _bordered(crop._pooled, crop._off_x, grid.resolution),
-        np.ascontiguousarray(crop._off_x[: settings.crop_cells]),
+        crop._table,
+        crop._centres,
         np.concatenate([[True], grid.blocked.ravel()]),
         np.array([x0, y0, 2.0 / (x1 - x0), 2.0 / (y1 - y0), math.hypot(x1 - x0, y1 - y0)]),
     )
-
-
-def _bordered(pooled: np.ndarray, offsets: np.ndarray, resolution: float) -> np.ndarray:
-    """Uint8: ``pooled`` (1 blocked, 0 free) inside a border of blocked cells wider than
-    the crop's reach from any point of the map (its corner's distance, max |offset|
-    times sqrt 2 m, and 3 cells), the crop's look-up table (a quarter of float32's
-    cache lines: the look-up is the crop's larger part)."""
-    pad = math.ceil(math.sqrt(2.0) * np.abs(offsets).max() / resolution) + 3
-    return np.pad(pooled.astype(np.uint8), pad, constant_values=1)
 
 
 def _rules(scenario: Scenario) -> Rules:
