@@ -22,10 +22,10 @@ import argparse
 import collections
 import importlib
 import json
-import os
-import subprocess
 import sys
 import time
+
+from ab_games import start_workers  # this script's directory is first on sys.path
 
 TICKS = 900  # control ticks of a default game: 90 s at 10 Hz
 
@@ -94,21 +94,7 @@ def main() -> None:
     parser.add_argument("--reps", type=int, default=4)
     parser.add_argument("--maps", default="enclosed,hall,brick")
     args = parser.parse_args()
-    workers = {}
-    for side in args.sides:
-        name, spec = side.split("=", 1)
-        python, checkout = spec.split(":", 1)
-        workers[name] = subprocess.Popen(
-            [python, os.path.abspath(__file__), "--worker"],
-            cwd=os.environ.get("TMPDIR", "/tmp"),
-            env={**os.environ, "PYTHONPATH": os.path.abspath(checkout)},
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-        )
-    for name, process in workers.items():
-        if process.stdout.readline().strip() != "ready":
-            sys.exit(f"worker {name} did not start")
+    workers = start_workers(args.sides, __file__, "--worker")
     names, maps = list(workers), args.maps.split(",")
     least: dict = {name: collections.defaultdict(dict) for name in names}
     for rep in range(args.reps):

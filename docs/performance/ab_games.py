@@ -69,6 +69,27 @@ def env_worker() -> None:
         print(f"{time.process_time() - start:.6f} {rate}", flush=True)
 
 
+def start_workers(sides: list[str], script: str, flag: str) -> dict[str, subprocess.Popen]:
+    """One worker process per NAME=PYTHON:CHECKOUT side, running ``script flag`` with the
+    checkout first on PYTHONPATH, each ready (it has printed "ready"), by name."""
+    workers = {}
+    for side in sides:
+        name, spec = side.split("=", 1)
+        python, checkout = spec.split(":", 1)
+        workers[name] = subprocess.Popen(
+            [python, os.path.abspath(script), flag],
+            cwd=os.environ.get("TMPDIR", "/tmp"),
+            env={**os.environ, "PYTHONPATH": os.path.abspath(checkout)},
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+    for name, process in workers.items():
+        if process.stdout.readline().strip() != "ready":
+            sys.exit(f"worker {name} did not start")
+    return workers
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("sides", nargs="+", help="NAME=PYTHON:CHECKOUT, the first is the reference")
@@ -83,22 +104,7 @@ def main() -> None:
     args = parser.parse_args()
     maps = args.maps.split(",")
     seeds = [int(s) for s in args.seed_list.split(",")] if args.seed_list else range(args.seeds)
-    workers = {}
-    for side in args.sides:
-        name, spec = side.split("=", 1)
-        python, checkout = spec.split(":", 1)
-        env = {**os.environ, "PYTHONPATH": os.path.abspath(checkout)}
-        workers[name] = subprocess.Popen(
-            [python, os.path.abspath(__file__), "--env-worker" if args.env else "--worker"],
-            cwd=os.environ.get("TMPDIR", "/tmp"),
-            env=env,
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-        )
-    for name, process in workers.items():
-        if process.stdout.readline().strip() != "ready":
-            sys.exit(f"worker {name} did not start")
+    workers = start_workers(args.sides, __file__, "--env-worker" if args.env else "--worker")
     names = list(workers)
     best: dict[str, dict[str, dict[int, float]]] = {n: {m: {} for m in maps} for n in names}
     rows = []
