@@ -424,7 +424,7 @@ class TickLoop:
     def _advance_1v1(self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None) -> Tick:
         """:meth:`advance` for one pursuer against one evader moving together: the same
         tick in the same order, without the per-member lists and comprehensions of a
-        team's tick, which cost 3-4% of a whole 1v1 game of two strategies (README,
+        team's tick, which cost about 3% of a whole 1v1 game of two strategies (README,
         Performance; the most played ticks: Game.play, sweeps and the environments).
         ``tests/test_loop.py`` plays built-in pairings, and external roles, both ways and
         requires the same ticks; set ``one_on_one`` False to take the general form."""

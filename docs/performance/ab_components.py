@@ -25,7 +25,7 @@ import json
 import sys
 import time
 
-from ab_games import start_workers  # this script's directory is first on sys.path
+from ab_games import in_turn, start_workers  # this script's directory is first on sys.path
 
 TICKS = 900  # control ticks of a default game: 90 s at 10 Hz
 
@@ -100,13 +100,9 @@ def main() -> None:
     for rep in range(args.reps):
         for env in maps:
             for seed in range(args.seeds):
-                turn = (rep + seed) % len(names)
-                for name in names[turn:] + names[:turn]:
-                    process = workers[name]
-                    process.stdin.write(f"{env} {seed}\n")
-                    process.stdin.flush()
+                for name, line in in_turn(workers, rep + seed, env, seed):
                     kept = least[name][(env, seed)]
-                    for component, ns in json.loads(process.stdout.readline()).items():
+                    for component, ns in json.loads(line).items():
                         kept[component] = min(kept.get(component, ns), ns)
     for process in workers.values():
         process.stdin.close()
