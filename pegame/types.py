@@ -40,44 +40,53 @@ def clamp(value: float, limit: float) -> float:
 _T = TypeVar("_T")
 
 
+def _slot(cls: type, name: str) -> Any:
+    """The slot descriptor of field ``name`` of the slotted class ``cls`` (or a base's)."""
+    return next(vars(k)[name] for k in cls.__mro__ if name in vars(k))
+
+
 @overload
 def value_type(cls: type[_T], /) -> type[_T]: ...
 @overload
 def value_type(*, eq: bool = True) -> Callable[[type[_T]], type[_T]]: ...
 @dataclass_transform(frozen_default=True)
 def value_type(cls: type[_T] | None = None, /, *, eq: bool = True) -> Any:
-    """``dataclass(frozen=True, eq=eq)``, whose ``__init__`` stores the fields straight
-    into the instance's ``__dict__``.
+    """``dataclass(frozen=True, eq=eq, slots=True)``, whose ``__init__`` stores each field
+    through its slot's descriptor.
 
     The ``__init__`` a frozen dataclass generates sets each field through
     ``object.__setattr__``, about 0.2 us a field on CPython 3.11; a game tick builds some
     ten value objects (poses, commands, the camera frame, observations, the tick record),
-    so those calls alone were several percent of a game. The instances are the same:
-    frozen (assignment raises ``FrozenInstanceError``), with the same fields, defaults,
-    ``__post_init__``, equality, hash and repr (``tests/test_value_types.py`` compares
-    them with plain frozen dataclasses). Classes with ``default_factory`` fields, fields
-    left out of ``__init__`` or keyword-only fields keep the dataclass's own
-    ``__init__``.
+    so those calls alone were several percent of a game. Slots also make every field read
+    CPython 3.11's specialised slot load: an instance ``__dict__`` filled by hand (the
+    previous form of this ``__init__``) left 3.11's attribute caches missing on every read
+    (a split dict, which its ``LOAD_ATTR_WITH_HINT`` cannot read), and cost a dict per
+    object. The instances are the same: frozen (assignment raises
+    ``FrozenInstanceError``), with the same fields, defaults, ``__post_init__``, equality,
+    hash, pickling and repr (``tests/test_value_types.py`` compares them with plain
+    frozen dataclasses), but no ``__dict__``: a value type holds its fields only. Classes
+    with ``default_factory`` fields, fields left out of ``__init__`` or keyword-only fields
+    keep the dataclass's own ``__init__``.
     """
 
     def wrap(cls: type[_T]) -> type[_T]:
-        cls = dataclass(frozen=True, eq=eq)(cls)
+        cls = dataclass(frozen=True, eq=eq, slots=True)(cls)
         fields = dataclasses.fields(cls)  # type: ignore[arg-type]  # a dataclass now
         if any(
             f.default_factory is not dataclasses.MISSING or not f.init or f.kw_only for f in fields
         ):
             return cls
-        defaults = {f"_default_{f.name}": f.default for f in fields}
+        names: dict[str, Any] = {f"_default_{f.name}": f.default for f in fields}
+        names |= {f"_set_{f.name}": _slot(cls, f.name).__set__ for f in fields}
         params = ", ".join(
             f.name if f.default is dataclasses.MISSING else f"{f.name}=_default_{f.name}"
             for f in fields
         )
-        body = ["    fields = self.__dict__"]
-        body += [f"    fields[{f.name!r}] = {f.name}" for f in fields]
+        body = [f"    _set_{f.name}(self, {f.name})" for f in fields]
         if hasattr(cls, "__post_init__"):
             body.append("    self.__post_init__()")
         namespace: dict[str, Any] = {}
-        exec(f"def __init__(self, {params}):\n" + "\n".join(body), defaults, namespace)
+        exec(f"def __init__(self, {params}):\n" + "\n".join(body), names, namespace)
         init = namespace["__init__"]
         init.__qualname__ = f"{cls.__qualname__}.__init__"
         init.__doc__ = cls.__init__.__doc__

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from importlib.metadata import EntryPoint
 from pathlib import Path
 
@@ -66,7 +67,7 @@ def env_rollout(env_id: str, policy, opponent: str, seed: int = 5, **settings) -
     obs, _ = env.reset(seed=seed)
     loop, rows, truncated = env.game.loop, [], False
     while not truncated:
-        rows.append((*vars(loop.pursuer).values(), *vars(loop.evader).values()))
+        rows.append((*dataclasses.astuple(loop.pursuer), *dataclasses.astuple(loop.evader)))
         obs, _, _, truncated, _ = env.step(np.clip(policy(obs), -1.0, 1.0))
     return np.array(rows)
 

@@ -85,6 +85,23 @@ class EnvGame:
             for role in self.roles
             for agent in self.members[role]
         }
+        #: (agent, pursuer index i, its target evader i mod M, features) per learning pursuer
+        self._pursuer_agents = [
+            (agent, i, i % sizes["evader"], self.member_features[agent])
+            for i, agent in enumerate(self.members.get("pursuer", ()))
+        ]
+        #: (agent, evader index j, features) per learning evader
+        self._evader_agents = [
+            (agent, j, self.member_features[agent])
+            for j, agent in enumerate(self.members.get("evader", ()))
+        ]
+        #: (role, body, [(agent, name in errors)]) per learning role; a 1v1 game's roles
+        #: are commanded with one velocity each, a team's with one per member
+        self._actors = [
+            (role, self.bodies[role], [(agent, f"{agent} action") for agent in self.members[role]])
+            for role in self.roles
+        ]
+        self._agent_set = frozenset(self.agents)
         self.evader_detections = [0] * sizes["evader"]  # in the last step, per evader
         self.seed: int | None = None
         self.loop: TickLoop | None = None
@@ -117,10 +134,12 @@ class EnvGame:
             raise RuntimeError("No game in progress: call reset() before step().")
         commands = self._commands(actions)
         detections = [0] * len(self.evader_detections)
+        evaders = range(len(detections))
         for _ in range(self.ticks_per_action):
             loop.advance(commands)
-            for j in range(len(detections)):  # loops, not generators: once per tick
-                for row in loop.detections:
+            rows = loop.detections
+            for j in evaders:  # loops, not generators: once per tick
+                for row in rows:
                     if row[j] is not None:
                         detections[j] += 1
                         break
@@ -133,12 +152,13 @@ class EnvGame:
     def observations(self) -> dict[str, np.ndarray]:
         """Each learning agent's observation at the current tick (new arrays)."""
         loop, out = self.loop, {}
-        for i, agent in enumerate(self.members.get("pursuer", ())):
-            belief = loop.beliefs[i % len(loop.beliefs)]
-            out[agent] = self.member_features[agent].build(loop.time, loop.pursuers[i], belief)
-        for j, agent in enumerate(self.members.get("evader", ())):
-            near = nearest(loop.pursuers, loop.evaders[j])
-            out[agent] = self.member_features[agent].build(loop.evaders[j], loop.pursuers[near])
+        time, pursuers = loop.time, loop.pursuers
+        for agent, i, j, features in self._pursuer_agents:
+            out[agent] = features.build(time, pursuers[i], loop.beliefs[j])
+        for agent, j, features in self._evader_agents:
+            evader = loop.evaders[j]
+            near = 0 if len(pursuers) == 1 else nearest(pursuers, evader)
+            out[agent] = features.build(evader, pursuers[near])
         return out
 
     def info(self) -> dict:
@@ -151,28 +171,29 @@ class EnvGame:
 
     def _remember(self) -> None:
         loop = self.loop
-        for i, agent in enumerate(self.members.get("pursuer", ())):
-            detection = loop.detections[i][i % len(loop.evaders)]
-            self.member_features[agent].remember(loop.time, detection)
+        for _, i, j, features in self._pursuer_agents:
+            features.remember(loop.time, loop.detections[i][j])
 
     def _commands(self, actions: Mapping[str, object]) -> dict:
+        """The learners' ``actions`` as the tick loop's commands: role -> velocity in a 1v1
+        game, role -> one velocity per member in a team game."""
         if not isinstance(actions, Mapping):
             raise ValueError(
                 f"actions must map each agent in {self.agents} to its action, got {actions!r}."
             )
-        unknown = sorted(set(actions) - set(self.agents))
-        missing = [agent for agent in self.agents if agent not in actions]
-        if unknown or missing:
+        if actions.keys() != self._agent_set:
+            unknown = sorted(set(actions) - self._agent_set)
+            missing = [agent for agent in self.agents if agent not in actions]
             raise ValueError(
                 f"actions must have exactly the agents {self.agents}; "
                 f"missing {missing}, unexpected {unknown}."
             )
-        commands = {}
-        for role in self.roles:  # loops, not comprehensions: once per step
-            body, clip = self.bodies[role], self.settings.clip_actions
-            commands[role] = velocities = []
-            for agent in self.members[role]:
-                velocities.append(to_velocity(actions[agent], body, clip, f"{agent} action"))
+        commands, clip = {}, self.settings.clip_actions
+        for role, body, members in self._actors:  # loops, not comprehensions: once per step
+            velocities = []
+            for agent, who in members:
+                velocities.append(to_velocity(actions[agent], body, clip, who))
+            commands[role] = velocities[0] if len(velocities) == 1 else velocities
         return commands
 
     def close(self) -> None:
