@@ -5,12 +5,16 @@
 Best of 5 repeats, in us per call, on the enclosed map: the smart evader's cell centres of
 500 cells (one numba pass against the numpy passes of ``cell_to_world``), the single env's
 32 x 32 crop (the lattice route against the division), ``Planner.shared`` (its cached
-parameters against binding the constructor's signature) and the particle filter's
-deterministic exp of 2000 arguments against numpy's.
+parameters against binding the constructor's signature), the particle filter's
+deterministic exp of 2000 arguments against numpy's, and building a ``Pose`` and reading
+its fields 30 times: the slotted value type against an ``__init__`` that fills the
+instance ``__dict__`` (this release's earlier form) and the plain frozen dataclass (the
+previous release's).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
 import timeit
@@ -23,6 +27,32 @@ from pegame.game import Game
 from pegame.grid.cells import cell_centres
 from pegame.navigation.planner import Planner
 from pegame.trig import exps
+from pegame.types import Pose
+
+
+@dataclasses.dataclass(frozen=True)
+class PlainPose:
+    """The previous release's value type: a plain frozen dataclass."""
+
+    x: float
+    y: float
+    theta: float = 0.0
+
+
+class DictPose(PlainPose):
+    """This release's earlier value type: the fields written into the instance dict."""
+
+    def __init__(self, x: float, y: float, theta: float = 0.0) -> None:
+        fields = self.__dict__
+        fields["x"], fields["y"], fields["theta"] = x, y, theta
+
+
+def thirty_reads(pose) -> float:
+    """Read the fields of ``pose`` 30 times."""
+    total = 0.0
+    for _ in range(10):
+        total += pose.x + pose.y + pose.theta
+    return total
 
 
 def per_call_us(function, number: int = 2000) -> float:
@@ -64,6 +94,22 @@ def main() -> None:
             lambda: np.exp(exponents),
         ),
     ]
+    for other in (DictPose, PlainPose):
+        pose, reference = Pose(1.0, 2.0, 0.5), other(1.0, 2.0, 0.5)
+        rows.append(
+            (
+                f"Pose built / {other.__name__}",
+                lambda: Pose(1.0, 2.0, 0.5),
+                lambda other=other: other(1.0, 2.0, 0.5),
+            )
+        )
+        rows.append(
+            (
+                f"30 Pose reads / {other.__name__}",
+                lambda pose=pose: thirty_reads(pose),
+                lambda reference=reference: thirty_reads(reference),
+            )
+        )
     for name, new, old in rows:
         new(), old()  # compile and warm
         print(
