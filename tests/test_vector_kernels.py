@@ -56,7 +56,7 @@ def test_crop_is_the_reference_crop(game):
     rng = np.random.default_rng(2)
     x0, x1, y0, y1 = grid.extent
     out = np.empty(settings.crop_cells**2, np.float32)
-    cells = np.empty(settings.crop_cells**2, np.int64)
+    cells = np.empty(settings.crop_cells**2, np.int32)
     for x, y, theta in zip(
         rng.uniform(x0 - 2, x1 + 2, 200), rng.uniform(y0 - 2, y1 + 2, 200), rng.uniform(-4, 4, 200)
     ):
@@ -75,7 +75,7 @@ def test_crop_on_cell_edges_is_the_reference_crop(game):
     settings = game.settings
     res, (gx, gy, _) = grid.resolution, grid.origin
     out = np.empty(settings.crop_cells**2, np.float32)
-    cells = np.empty(settings.crop_cells**2, np.int64)
+    cells = np.empty(settings.crop_cells**2, np.int32)
     rng = np.random.default_rng(7)
     height, width = grid.blocked.shape
     slow = []
@@ -115,7 +115,7 @@ def test_crop_on_a_rotated_far_off_grid_is_the_reference_crop(game):
     res, (gx, gy, yaw) = rotated.resolution, rotated.origin
     height, width = rotated.blocked.shape
     out = np.empty(settings.crop_cells**2, np.float32)
-    cells = np.empty(settings.crop_cells**2, np.int64)
+    cells = np.empty(settings.crop_cells**2, np.int32)
     slow = []
     for i in range(600):
         u, v = rng.uniform(-40, width + 40) * res, rng.uniform(-40, height + 40) * res

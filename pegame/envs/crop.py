@@ -102,6 +102,9 @@ _EDGE = 2.0**-20
 _DECIDED = 0.5 - _EDGE
 #: the largest size L (cells, see :func:`_lattice_crop`) for which the lattice decides
 _SIZE_LIMIT = 2.0**21
+#: tables of at least this many cells are not looked up by the lattice: its flat cell
+#: indices are int32 (AVX2 converts four float64 to int32 at once, but int64 one at a time)
+_TABLE_LIMIT = 2**31
 
 
 @njit(cache=True, inline="always")
@@ -137,8 +140,10 @@ def lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, colum
     ``frame`` the crop's map-to-cell numbers as float64 (gx, gy, cos, sin, rotated, res),
     ``width`` the map's in cells), the pooled map with a border of blocked cells, so
     that no cell needs a test against the map's edges; the coordinates' cells are found
-    in one vectorised pass (flat indices into ``cells``) and looked up in a second, a
-    gather that does not vectorise (an unsigned index: no test for negative ones).
+    in one vectorised pass (flat int32 indices into ``cells``, int32 scratch of the
+    crop's size: a table of 2**31 cells or more is left to the division) and looked up
+    in a second, a gather that does not vectorise (an unsigned index: no test for
+    negative ones).
     """
     gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
     padded_height, padded_width = table.shape
@@ -155,6 +160,7 @@ def lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, colum
     size = (abs(x) + abs(y) + abs(gx) + abs(gy) + 4.0 * top) * inverse
     if not (
         size <= _SIZE_LIMIT
+        and table.size < _TABLE_LIMIT
         and u0 - reach_u > -pad
         and u0 + reach_u < padded_width - pad
         and v0 - reach_v > -pad
@@ -174,10 +180,10 @@ def lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, colum
             v = row_v + columns[1, j]
             col, row = np.floor(u), np.floor(v)
             bad |= (abs(u - col - 0.5) >= _DECIDED) | (abs(v - row - 0.5) >= _DECIDED)
-            cells[i * n + j] = np.int64(row * stride + col + origin)
+            cells[i * n + j] = np.int32(row * stride + col + origin)
     flat = table.reshape(-1)
     for k in range(n * n):
-        out[at + k] = flat[np.uint64(cells[k])]
+        out[at + k] = flat[np.uint32(cells[k])]
     return not bad
 
 
@@ -216,7 +222,7 @@ class LocalCrop:
         self._table = bordered_table(self._pooled, self._off_x, grid.resolution)
         self._centres = np.ascontiguousarray(self._off_x[:cells])
         self._frame = np.array(self._origin, dtype=np.float64)
-        self._cells = np.empty(self.size, dtype=np.int64)
+        self._cells = np.empty(self.size, dtype=np.int32)
         self._columns = np.empty((2, cells))
 
     def __call__(

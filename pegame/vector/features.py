@@ -59,7 +59,7 @@ def _divided_crop(world, x, y, c, s, out, at):
 @njit(cache=True)
 def crop_into(world, x, y, theta, out, at, cells):
     """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
-    rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int64
+    rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int32
     scratch of the crop's size): from the crop's lattice (:func:`pegame.envs.crop.lattice_crop`), or by
     the division when the lattice does not decide every cell (a pose on cell edges), as
     the features' loop finds them. Returns whether the division was needed.
@@ -117,7 +117,7 @@ _BLOCK = 64
 def _features_block(world, rules, state, out, pursuer, block):
     """The rows of the games of ``block``: the arrays are taken out of the NamedTuples
     once per block, not per game."""
-    cells = np.empty(world.crop_x.size, np.int64)
+    cells = np.empty(world.crop_x.size, np.int32)
     columns = np.empty((2, world.crop_centres.size))
     extent, table, centres = world.extent, world.crop_table, world.crop_centres
     frame, width = world.crop_frame, world.pooled.shape[1]
