@@ -15,13 +15,15 @@ estimate ``Ir + 10 (L1 misses + mispredicted branches) + 100 LL misses`` (KCache
 the first side. The estimate is a model, not a time: ``ab_games.py`` measures time.
 
 Workloads, on each map of ``--maps``: ``visibility`` (Algorithm 1 from 50 poses,
-``pegame.bench.bench_visibility``), ``planner`` (20 distance fields and 20 plans),
+``pegame.bench.bench_visibility``), ``planner`` (20 distance fields and 20 plans,
+``bench_planner``), ``plans`` (20 A* plans between free poses, on their own),
 ``decisions`` (``pegame.bench.bench_decisions`` with 10 repeats, its set-up included);
 the decisions on their own, 20 each: ``filter`` (particle filter updates, 2000 particles,
 regions given), ``pursuer`` (smart pursuer decisions, each after its filter update),
-``evader`` (smart evader decisions); ``sim`` (2000 grid-simulator steps), ``game`` (one 90 s S-S game, seed 0,
-recorder=none) and ``env`` (one PettingZoo episode of random actions, seed 0). A side
-takes about two minutes a workload; the sides run two at a time (``--jobs``).
+``evader`` (smart evader decisions); ``sim`` (2000 grid-simulator steps), ``game`` (one
+90 s S-S game, seed 0, recorder=none) and ``env`` (one PettingZoo episode of random
+actions, seed 0). A side takes about two minutes a workload; the sides run two at a time
+(``--jobs``).
 """
 
 from __future__ import annotations
@@ -67,6 +69,10 @@ def workload(name: str, map_name: str):
         return lambda: bench.bench_visibility(grid, 50)
     if name == "planner":
         return lambda: bench.bench_planner(grid, 20)
+    if name == "plans":
+        planner = bench.Planner(grid, 0.2)
+        poses = bench.free_poses(grid, 0.2, 40, seed=7)
+        return lambda: [planner.plan(a.xy, b.xy) for a, b in zip(poses[::2], poses[1::2])]
     if name == "decisions":
         return lambda: bench.bench_decisions(grid, 10)
     if name in ("filter", "pursuer", "evader"):
