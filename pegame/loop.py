@@ -317,7 +317,7 @@ class TickLoop:
         """What evader ``j`` is given at this tick: the pursuer nearest to it and the
         union of the pursuers' regions."""
         me = self.evaders[j]
-        near = 0 if self.n_pursuers == 1 else nearest(self.pursuers, me)
+        near = nearest(self.pursuers, me)
         return EvaderObservation(self.time, me, self.pursuers[near], self.union, self.pursuers, j)
 
     def advance(self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None = None) -> Tick:

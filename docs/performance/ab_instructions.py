@@ -31,6 +31,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -150,8 +151,10 @@ def worker(name: str, map_name: str) -> None:
     subprocess.run([*control, "off", str(os.getpid())], check=True, capture_output=True)
 
 
-def counts(side: str, name: str, map_name: str) -> dict[str, int]:
-    """callgrind's counts of one side's workload (NAME=PYTHON:CHECKOUT)."""
+def counts(side: str, name: str, map_name: str, keep: str | None = None) -> dict[str, int]:
+    """callgrind's counts of one side's workload (NAME=PYTHON:CHECKOUT); with ``keep`` a
+    directory, its profile is kept there as ``NAME-WORKLOAD-MAP.callgrind`` (per function:
+    ``callgrind_annotate``; numba's code has no symbols)."""
     python, checkout = side.split("=", 1)[1].split(":", 1)
     # the interpreter itself (a venv's keeps its venv), not a launcher script such as
     # pyenv's shim, which valgrind would trace instead
@@ -180,6 +183,9 @@ def counts(side: str, name: str, map_name: str) -> dict[str, int]:
             check=True,
         )
         text = open(log, encoding="utf-8").read()
+        if keep is not None:
+            kept = os.path.join(keep, f"{side.split('=')[0]}-{name}-{map_name}.callgrind")
+            shutil.copyfile(os.path.join(scratch, "callgrind.out"), kept)
     found = {}
     for key, pattern in COUNTS.items():
         match = re.search(pattern + r":\s+([\d,]+)", text)
@@ -200,7 +206,10 @@ def main() -> None:
     parser.add_argument("--maps", default="hall")
     parser.add_argument("--workloads", default=",".join(WORKLOADS))
     parser.add_argument("--jobs", type=int, default=2, help="valgrind processes at a time")
+    parser.add_argument("--keep", metavar="DIR", help="keep each run's callgrind profile in DIR")
     args = parser.parse_args()
+    if args.keep:
+        os.makedirs(args.keep, exist_ok=True)
     tasks = [
         (side, name, map_name)
         for map_name in args.maps.split(",")
@@ -208,7 +217,7 @@ def main() -> None:
         for side in args.sides
     ]
     with ThreadPoolExecutor(args.jobs) as pool:
-        results = dict(zip(tasks, pool.map(lambda task: counts(*task), tasks)))
+        results = dict(zip(tasks, pool.map(lambda task: counts(*task, args.keep), tasks)))
     reference = args.sides[0]
     for map_name in args.maps.split(","):
         for name in args.workloads.split(","):

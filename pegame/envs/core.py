@@ -157,8 +157,7 @@ class EnvGame:
             out[agent] = features.build(time, pursuers[i], loop.beliefs[j])
         for agent, j, features in self._evader_agents:
             evader = loop.evaders[j]
-            near = 0 if len(pursuers) == 1 else nearest(pursuers, evader)
-            out[agent] = features.build(evader, pursuers[near])
+            out[agent] = features.build(evader, pursuers[nearest(pursuers, evader)])
         return out
 
     def info(self) -> dict:
