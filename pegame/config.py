@@ -252,7 +252,7 @@ def resolve_map_path(map_path: str, base_dir: str | Path | None = None) -> Path:
     candidate = Path(base_dir or Path.cwd()) / path
     if candidate.exists():
         return candidate
-    shipped = Path(str(files("pegame.maps_data"))) / path
+    shipped = Path(str(files("pegame.maps"))) / path
     return shipped if shipped.exists() else candidate
 
 

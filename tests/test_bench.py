@@ -11,7 +11,7 @@ from pegame.grid import load_map
 
 
 def test_decision_benchmarks_time_each_part_on_a_paper_map():
-    grid = load_map(resolve_map_path("maps/enclosed.yaml"))
+    grid = load_map(resolve_map_path("enclosed.yaml"))
     timings = bench_decisions(grid, 3)
     assert set(timings) == {"pursuer_decision_ms", "evader_decision_ms", "pf_step_ms"}
     assert all(math.isfinite(ms) and ms > 0 for ms in timings.values())

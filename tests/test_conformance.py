@@ -32,11 +32,6 @@ from pegame.testing import (
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
-def flee(obs: np.ndarray) -> np.ndarray:
-    """An evader policy on the env observation: turn away from the pursuer and run."""
-    return np.array([1.0, -5.0 * obs[9]])
-
-
 class TestGridSimulator(SimulatorConformance):
     plugin = "grid"
 
@@ -88,7 +83,7 @@ class TestRandomEvader(EvaderConformance):
 
 class TestPolicyEvader(EvaderConformance):
     plugin = "policy"
-    overrides = ("evader.path=test_conformance:flee",)
+    overrides = ("evader.path=pegame.testing:flee",)
     bad_values = {"belief": True, "decision_period": -1.0}
 
 

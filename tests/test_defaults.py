@@ -30,7 +30,7 @@ tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
 ROOT = Path(__file__).resolve().parents[1]
 #: distribution directory -> its config root (pegame's conf/ is the package pegame.conf)
 DISTRIBUTIONS = {
-    ROOT: ROOT / "conf",
+    ROOT: ROOT / "pegame" / "conf",
     ROOT / "plugins" / "pegame_pybullet": None,
     ROOT / "plugins" / "pegame_vision": None,
     ROOT / "examples" / "pegame_spinner": None,
@@ -185,7 +185,7 @@ def test_the_config_file_repeats_the_dataclass(option, monkeypatch):
 
 
 def config_yaml() -> tuple[str, dict[str, Any]]:
-    text = (ROOT / "conf" / "config.yaml").read_text()
+    text = (ROOT / "pegame" / "conf" / "config.yaml").read_text()
     return text, yaml.safe_load(text)
 
 

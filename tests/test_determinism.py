@@ -16,12 +16,11 @@ import os
 import platform
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
-from reference_games import DATA
 
-HERE = Path(__file__).resolve().parent
+from pegame.testing.reference_games import DATA, belief_digest
+
 #: one game per kind of kernel work: the particle filter's weighing and resampling (three
 #: schemes), the smart evader's search, the planners and the Kalman filter
 LABELS = ("S-S enclosed", "S-S residual", "S-S multinomial", "S-S kalman", "R-S brick")
@@ -29,30 +28,11 @@ NUMPY_SIMD = "X86_V3 X86_V4 AVX512_ICL AVX512_SPR"
 
 PLAY = """
 import json, sys
-sys.path.insert(0, sys.argv[1])
-from reference_games import CASES, play
-from test_determinism import belief_digest
+from pegame.testing.reference_games import CASES, belief_digest, play
 cases = dict(CASES)
-games = json.loads(sys.argv[2])
+games = json.loads(sys.argv[1])
 print(json.dumps([[play(cases[g["label"]], g["seed"]) for g in games], belief_digest()]))
 """
-
-
-def belief_digest() -> str:
-    """sha256 of every tick's particles and weights in a short S-S game: far more sensitive
-    than the measures, which ulp-level differences rarely reach."""
-    import hashlib
-
-    from pegame.config import compose
-    from pegame.game import Game
-
-    loop = Game(compose(["game.t_max=10", "recorder=none", "env=brick"])).start()
-    digest = hashlib.sha256()
-    while not loop.done:
-        loop.advance()
-        digest.update(loop.belief.particles.tobytes())
-        digest.update(loop.belief.weights.tobytes())
-    return digest.hexdigest()
 
 
 @pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="x86-64 CPU names")
@@ -66,7 +46,7 @@ def test_reference_games_are_the_same_with_kernels_for_a_generic_cpu(tmp_path):
         "NPY_DISABLE_CPU_FEATURES": NUMPY_SIMD,
     }
     done = subprocess.run(
-        [sys.executable, "-c", PLAY, str(HERE), json.dumps(games)],
+        [sys.executable, "-c", PLAY, json.dumps(games)],
         env=env,
         capture_output=True,
         text=True,

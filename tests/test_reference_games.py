@@ -11,7 +11,8 @@ from __future__ import annotations
 import json
 
 import pytest
-from reference_games import CASES, DATA, play
+
+from pegame.testing.reference_games import CASES, DATA, play
 
 STORED = json.loads(DATA.read_text())
 OVERRIDES = dict(CASES)

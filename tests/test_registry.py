@@ -61,7 +61,27 @@ def test_import_failure_names_plugin_distribution_and_install_hint(fake_points):
     assert "pip install pegame_missing_dependency_xyz" in text
 
 
-def test_class_that_is_not_the_interface_is_a_plugin_error_naming_the_methods(fake_points):
+BROKEN_PLUGINS = '''
+from pegame.api import Pursuer
+
+
+class HalfPursuer(Pursuer):
+    """Forgets to implement decide and control."""
+
+    def reset(self, pose):
+        pass
+
+
+class NotAPlugin:
+    """Implements nothing of the interface."""
+'''
+
+
+def test_class_that_is_not_the_interface_is_a_plugin_error_naming_the_methods(
+    fake_points, tmp_path, monkeypatch
+):
+    (tmp_path / "fake_plugins.py").write_text(BROKEN_PLUGINS)
+    monkeypatch.syspath_prepend(str(tmp_path))
     fake_points(alien="fake_plugins:NotAPlugin", half="fake_plugins:HalfPursuer")
     with pytest.raises(registry.PluginError, match="must be a subclass of pegame.api.Pursuer"):
         registry.load("pursuer", "alien")

@@ -19,7 +19,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from slurm_cluster import SlurmCluster, SlurmUnavailable, start_cluster
+
+from pegame.testing.slurm import SlurmCluster, SlurmUnavailable, start_cluster
 
 # One cluster at a time, and the sweeps want both cores: under pytest-xdist
 # (--dist loadgroup) these tests share one worker.

@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_grid_sim import room
 
 from pegame.api import Context, Evader, Pursuer, Simulator
 from pegame.config import GameConfig, compose
@@ -19,6 +18,7 @@ from pegame.game import Game
 from pegame.loop import TickLoop
 from pegame.navigation import inflate
 from pegame.sims.grid import GridSimulator, unicycle
+from pegame.testing import walled_room
 from pegame.types import Body, Camera, Plan, Pose, Velocity
 
 SHORT = ["recorder=none", "env=enclosed"]
@@ -110,7 +110,7 @@ def test_commands_held_over_substeps_drive_the_path_of_the_fast_control_rate(eva
     control_dt=st.sampled_from([0.1, 0.5, 1.0]),
 )
 def test_substeps_never_enter_walls(seed, substeps, control_dt):
-    grid = room()
+    grid = walled_room()
     pursuer, evader = Body(0.2, 0.8, 3.0), Body(0.25, 0.8, 3.0)
     context = Context(grid, pursuer, evader, Camera(), control_dt, control_dt)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
@@ -158,7 +158,7 @@ def test_the_pybullet_sim_refuses_acceleration_limits_and_turns():
 
 def accelerating_sim(a_max=0.5, alpha_max=1.0):
     body = Body(0.2, 0.8, 3.0, a_max=a_max, alpha_max=alpha_max)
-    context = Context(room(), body, Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
+    context = Context(walled_room(), body, Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
     return GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
 
 
@@ -179,7 +179,7 @@ def test_a_straight_drive_from_rest_ramps_at_a_max():
 def test_speed_and_turn_rate_change_at_most_a_max_dt_per_step(seed, dt):
     a_max, alpha_max = 0.5, 1.0
     sim = accelerating_sim(a_max, alpha_max)
-    grid = room()
+    grid = walled_room()
     sim.reset(Pose(*grid.cell_to_world(10, 10)), Pose(*grid.cell_to_world(50, 70)))
     rng = np.random.default_rng(seed)
     agent = sim._pursuers[0]

@@ -18,7 +18,7 @@ from pegame.trig import (
 from pegame.types import wrap_angle
 
 
-@njit(cache=True)
+@njit
 def sin_cos_of(angles):
     sines, cosines = np.empty(angles.size), np.empty(angles.size)
     for i in range(angles.size):

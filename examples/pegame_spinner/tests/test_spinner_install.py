@@ -2,28 +2,20 @@
 its entry point registers the pursuer and its pegame.configs entry point its config file.
 
 The distribution is made visible to the subprocesses through a hand-written dist-info on
-PYTHONPATH (spinner_dist), without changing the environment."""
+PYTHONPATH (the ``installed_env`` fixture), without changing the environment."""
 
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
-from pathlib import Path
 
-from spinner_dist import EXAMPLE, write_dist_info
-
-
-def fake_install(site: Path) -> dict[str, str]:
-    write_dist_info(site)
-    env = {k: v for k, v in os.environ.items() if k != "HYDRA_FULL_ERROR"}
-    env["PYTHONPATH"] = os.pathsep.join([str(site), str(EXAMPLE), env.get("PYTHONPATH", "")])
-    return env
+import pytest
 
 
-def test_the_example_plugin_is_listed_and_plays(tmp_path):
-    env = fake_install(tmp_path / "site")
+@pytest.mark.slow
+def test_the_example_plugin_is_listed_and_plays(tmp_path, installed_env):
+    env = installed_env
     listing = subprocess.run(
         [sys.executable, "-m", "pegame.catalog"],
         env=env,

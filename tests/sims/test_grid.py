@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from pegame.api import Context
-from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from pegame.navigation import inflate
 from pegame.sims.grid import (
     GridSimulator,
@@ -18,21 +17,12 @@ from pegame.sims.grid import (
     saturate,
     unicycle,
 )
+from pegame.testing import walled_room
 from pegame.types import Body, Camera, Pose, Velocity
 
 PURSUER = Body(radius=0.2, v_max=0.5, w_max=1.8)
 EVADER = Body(radius=0.25, v_max=0.5, w_max=1.8)
 DT = 0.1
-
-
-def room(origin=(0.0, 0.0, 0.0)):
-    """A 4 m x 3 m walled room (0.05 m cells) with a pillar and a few unknown cells."""
-    data = np.full((60, 80), FREE, dtype=np.int8)
-    data[[0, -1], :] = OCCUPIED
-    data[:, [0, -1]] = OCCUPIED
-    data[25:35, 35:45] = OCCUPIED
-    data[10, 60:63] = UNKNOWN
-    return OccupancyGrid(data, 0.05, origin)
 
 
 def simulator(grid):
@@ -47,7 +37,7 @@ def test_saturate_clips_to_the_body_limits():
 
 
 def test_free_motion_is_the_exact_unicycle_arc():
-    sim = simulator(room())
+    sim = simulator(walled_room())
     start = Pose(1.0, 1.0, 0.3)
     sim.reset(start, Pose(3.5, 2.5))
     for cmd in (Velocity(0.4, 0.0), Velocity(0.4, 1.0), Velocity(-0.2, -0.5)):
@@ -64,7 +54,7 @@ def test_free_motion_is_the_exact_unicycle_arc():
 
 
 def test_an_agent_stops_at_a_wall_and_can_still_turn():
-    grid = room()
+    grid = walled_room()
     sim = simulator(grid)
     sim.reset(Pose(1.0, 1.5, 0.0), Pose(3.5, 2.5))  # heading at the pillar's left face x = 1.75
     for _ in range(40):
@@ -77,7 +67,7 @@ def test_an_agent_stops_at_a_wall_and_can_still_turn():
 
 @pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-1.2, 0.7, 0.4)])
 def test_random_commands_never_enter_inflated_cells(origin):
-    grid = room(origin)
+    grid = walled_room(origin)
     sim = simulator(grid)
     rng = np.random.default_rng(1)
     sim.reset(Pose(*grid.cell_to_world(10, 10)), Pose(*grid.cell_to_world(50, 70)))
@@ -97,7 +87,7 @@ def test_random_commands_never_enter_inflated_cells(origin):
 def test_fast_sweep_equals_reference():
     rng = np.random.default_rng(2)
     for origin in [(0.0, 0.0, 0.0), (0.3, -0.2, 1.1)]:
-        grid = room(origin)
+        grid = walled_room(origin)
         blocked = inflate(grid, PURSUER.radius)
         frame = grid.frame
         stops = 0
@@ -114,7 +104,7 @@ def test_fast_sweep_equals_reference():
 
 
 def test_start_inside_an_obstacle_is_refused():
-    sim = simulator(room())
+    sim = simulator(walled_room())
     with pytest.raises(ValueError, match="inside an obstacle"):
         sim.reset(Pose(0.1, 1.0), Pose(3.5, 2.5))
 
@@ -136,7 +126,7 @@ def test_finite_acceleration_ramps_towards_the_command():
 
 def test_a_wall_stops_the_forward_speed_and_keeps_the_turn_rate():
     body = Body(0.2, 0.5, 1.8, a_max=1.0, alpha_max=2.0)
-    context = Context(room(), body, EVADER, Camera(), DT, 1.0)
+    context = Context(walled_room(), body, EVADER, Camera(), DT, 1.0)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
     sim.reset(Pose(1.0, 1.5, 0.0), Pose(3.5, 2.5))  # heading at the pillar's left face
     for _ in range(40):
@@ -150,7 +140,7 @@ def test_a_wall_stops_the_forward_speed_and_keeps_the_turn_rate():
 
 def test_step_one_moves_one_agent_and_pauses_the_other():
     body = Body(0.2, 0.5, 1.8, a_max=1.0, alpha_max=2.0)
-    context = Context(room(), body, body, Camera(), DT, 1.0)
+    context = Context(walled_room(), body, body, Camera(), DT, 1.0)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
     sim.reset(Pose(1.0, 1.0, 0.0), Pose(3.0, 2.5, 0.0))
     sim.step(Velocity(0.5, 0.0), Velocity(0.5, 0.0), DT)

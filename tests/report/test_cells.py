@@ -11,9 +11,9 @@ import sys
 import numpy as np
 import pytest
 import yaml
-from report_fixtures import PROVENANCE, config_game, config_job, game, table_rows, write_job
 
 from pegame import report
+from pegame.testing.reports import PROVENANCE, config_game, config_job, game, table_rows, write_job
 
 
 def test_an_ablation_gives_one_row_per_value_not_one_merged_cell(tmp_path):

@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from report_fixtures import separated, sweep_games, write_job
 from scipy.stats import mannwhitneyu
 
 from pegame import report
 from pegame.config import compose
 from pegame.game import Game
+from pegame.testing.reports import separated, sweep_games, write_job
 
 SEEDS = range(8)
 

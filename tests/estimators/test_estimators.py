@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import fields
+from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,7 @@ from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 from pegame.types import Body, BoundingBox, Camera, Detection, Pose
 from pegame.visibility import MaskRegion, VisibilityRegion
 
-CONF = Path(__file__).resolve().parents[1] / "conf" / "estimator"
+CONF = Path(str(files("pegame.conf"))) / "estimator"
 DT = 0.1  # s, control period
 PURSUER = Pose(0.5, 0.5, 0.0)  # the estimators here do not use the pursuer's pose
 LOGGER = "pegame.estimators.particle_filter"

@@ -376,6 +376,24 @@ WALL_X = 2.0  # m, the near face of the small map's interior wall
 BLOCK = (45, 51, 10, 21)  # rows and cols [start, stop) of the small map's occupied block
 
 
+def chase(observation: np.ndarray) -> np.ndarray:
+    """A pursuer policy for ``pursuer=policy pursuer.path=pegame.testing:chase``: turn toward
+    the last detection's bearing (feature 6) and close to about 1.5 m (feature 5)."""
+    return np.array([4.0 * observation[5] - 1.2, 3.0 * observation[6]])
+
+
+def nan_policy(observation: np.ndarray) -> np.ndarray:
+    """A broken policy (a NaN speed), for the policy plugins' error tests."""
+    return np.array([np.nan, 0.0])
+
+
+def flee(observation: np.ndarray) -> np.ndarray:
+    """An evader policy for ``evader=policy evader.path=pegame.testing:flee``: full speed,
+    turning away from the pursuer's bearing (the env observation's feature 9, normalised
+    to [-1, 1])."""
+    return np.array([1.0, -5.0 * observation[9]])
+
+
 def small_map() -> OccupancyGrid:
     """4 m x 3 m at 5 cm: an interior wall two cells thick at x = 2.0-2.1 m from y = 0 to
     2.0 m, an occupied block (:data:`BLOCK`), unknown cells in the top-right corner."""
@@ -387,6 +405,19 @@ def small_map() -> OccupancyGrid:
     data[BLOCK[0] : BLOCK[1], BLOCK[2] : BLOCK[3]] = 100
     data[55:, 75:] = -1
     return OccupancyGrid(data, RESOLUTION, name="small")
+
+
+def walled_room(origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> OccupancyGrid:
+    """4 m x 3 m at 5 cm with a one-cell wall all round, a 0.5 m square pillar at
+    x 1.75-2.25 m, y 1.25-1.75 m (from ``origin``) and three unknown cells at y = 0.5 m."""
+    from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+
+    data = np.full((60, 80), FREE, dtype=np.int8)
+    data[[0, -1], :] = OCCUPIED
+    data[:, [0, -1]] = OCCUPIED
+    data[25:35, 35:45] = OCCUPIED
+    data[10, 60:63] = UNKNOWN
+    return OccupancyGrid(data, RESOLUTION, origin)
 
 
 def small_context(grid: OccupancyGrid | None = None) -> Context:

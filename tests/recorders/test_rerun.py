@@ -12,6 +12,7 @@ import math
 import subprocess
 import sys
 from collections import defaultdict
+from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
@@ -461,7 +462,7 @@ def test_recording_id_is_deterministic_per_place_and_config(tmp_path):
 
 
 def test_config_file_lists_every_field_with_its_default():
-    conf = Path(__file__).resolve().parents[1] / "conf" / "recorder" / "rerun.yaml"
+    conf = Path(str(files("pegame.conf"))) / "recorder" / "rerun.yaml"
     values = yaml.safe_load(conf.read_text())
     defaults = {f.name: f.default for f in dataclasses.fields(RerunRecorder.Config)}
     assert values == {"name": "rerun", **defaults}

@@ -6,6 +6,7 @@ import heapq
 import logging
 import math
 from collections import deque
+from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,7 @@ from pegame.registry import make_config
 from pegame.types import Body, Camera, Pose
 from pegame.visibility import VisibilityRegion, visibility_region
 
-MAPS_DIR = Path(__file__).resolve().parents[1] / "maps"
+MAPS_DIR = Path(str(files("pegame.maps")))
 
 RES = 0.1  # m per cell in every test grid
 CAMERA = Camera(fov=math.pi / 3, near=0.3, far=5.0, angle_step=0.004, distance_step=0.05)

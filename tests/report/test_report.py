@@ -13,9 +13,9 @@ import sys
 
 import numpy as np
 import pytest
-from report_fixtures import config_game, config_job, game, separated, sweep_games, write_job
 
 from pegame import report
+from pegame.testing.reports import config_game, config_job, game, separated, sweep_games, write_job
 
 
 def test_mean_is_the_sample_mean_and_ci_contains_the_population_mean(tmp_path):

@@ -17,23 +17,10 @@ from pegame.evaders.policy import PolicyEvader
 from pegame.game import Game
 from pegame.policies import LinearPolicy, load_policy
 from pegame.pursuers.policy import PolicyPursuer
+from pegame.testing import chase, flee
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SHORT = ["env=enclosed", "game.t_max=3", "recorder=none"]
-
-
-def chase(obs: np.ndarray) -> np.ndarray:
-    """A pursuer policy on the env observation: turn toward the last detection, keep 1.5 m."""
-    return np.array([4.0 * obs[5] - 1.2, 3.0 * obs[6]])
-
-
-def flee(obs: np.ndarray) -> np.ndarray:
-    """An evader policy: turn away from the pursuer (relative y) and run."""
-    return np.array([1.0, -5.0 * obs[9]])
-
-
-def broken(obs: np.ndarray) -> np.ndarray:
-    return np.array([np.nan, 0.0])
 
 
 @pytest.fixture(autouse=True)
@@ -78,7 +65,7 @@ def trajectory(outcome) -> np.ndarray:
 
 @pytest.mark.parametrize("evader", ["smart", "random"])
 def test_a_policy_pursuer_plays_exactly_as_in_pursuit_env(evader):
-    outcome = game("pursuer=policy", "pursuer.path=test_policy:chase", f"evader={evader}").play(
+    outcome = game("pursuer=policy", "pursuer.path=pegame.testing:chase", f"evader={evader}").play(
         "unused"
     )
     assert np.array_equal(trajectory(outcome), env_rollout("pegame/Pursuit-v0", chase, evader))
@@ -86,7 +73,9 @@ def test_a_policy_pursuer_plays_exactly_as_in_pursuit_env(evader):
 
 
 def test_a_policy_evader_plays_exactly_as_in_evasion_env():
-    outcome = game("evader=policy", "evader.path=test_policy:flee", "pursuer=smart").play("unused")
+    outcome = game("evader=policy", "evader.path=pegame.testing:flee", "pursuer=smart").play(
+        "unused"
+    )
     assert np.array_equal(trajectory(outcome), env_rollout("pegame/Evasion-v0", flee, "smart"))
 
 
@@ -117,7 +106,12 @@ def test_the_strategy_holds_its_action_for_the_decision_period():
         return np.zeros(2)
 
     cfg = compose(
-        [*SHORT, "pursuer=policy", "pursuer.path=test_policy:chase", "pursuer.decision_period=0.5"]
+        [
+            *SHORT,
+            "pursuer=policy",
+            "pursuer.path=pegame.testing:chase",
+            "pursuer.decision_period=0.5",
+        ]
     )
     pursuer = game_with_policy(cfg)
     pursuer.player.policy = counting
@@ -164,7 +158,7 @@ def test_the_evader_has_no_belief_option():
         ("", "Missing value for 'pursuer.path'"),
         ("missing.npz", "does not exist"),
         ("no_such_module:f", "cannot load"),
-        ("test_policy:SHORT", "not callable"),
+        ("pegame.testing:RESOLUTION", "not callable"),
     ],
 )
 def test_unusable_policies_are_config_errors(path, message):
@@ -187,9 +181,9 @@ def test_policy_files_are_checked(tmp_path):
 
 def test_a_nan_action_is_an_error_and_large_ones_are_clipped():
     with pytest.raises(ValueError, match="finite"):
-        game("pursuer=policy", "pursuer.path=test_policy:broken").play("unused")
+        game("pursuer=policy", "pursuer.path=pegame.testing:nan_policy").play("unused")
     pursuer = game_with_policy(
-        compose([*SHORT, "pursuer=policy", "pursuer.path=test_policy:chase"])
+        compose([*SHORT, "pursuer=policy", "pursuer.path=pegame.testing:chase"])
     )
     pursuer.player.policy = lambda obs: np.array([10.0, -10.0])
     command = pursuer.control(observation_at(pursuer, 0))

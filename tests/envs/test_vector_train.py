@@ -13,7 +13,7 @@ from pegame.config import compose
 from pegame.game import Game
 from pegame.policies import LinearPolicy
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def run_example(name: str, monkeypatch, *args: str) -> None:

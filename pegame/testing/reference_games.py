@@ -1,9 +1,10 @@
 """Reference games: every built-in plugin played on fixed seeds, their measures stored.
 
-``python tests/reference_games.py`` plays them and writes ``tests/data/reference_games.json``;
-``tests/test_reference_games.py`` plays them again and requires the same measures, so a
-refactoring that changes a game fails. Regenerate only for a change that is meant to
-change games, and say so in its commit.
+``python -m pegame.testing.reference_games`` (from a checkout) plays them and writes
+``tests/data/reference_games.json``; ``tests/test_reference_games.py`` plays them again and
+requires the same measures, so a refactoring that changes a game fails. Regenerate only for
+a change that is meant to change games, and say so in its commit. The cases need the
+checkout's ``examples/`` (a trained policy) and the pybullet and vision plugins.
 """
 
 from __future__ import annotations
@@ -12,8 +13,10 @@ import json
 import sys
 from pathlib import Path
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
-DATA = Path(__file__).resolve().parent / "data" / "reference_games.json"
+#: the checkout this module sits in (pegame/testing/ -> the repository root)
+CHECKOUT = Path(__file__).resolve().parents[2]
+EXAMPLES = CHECKOUT / "examples"
+DATA = CHECKOUT / "tests" / "data" / "reference_games.json"
 
 SHORT = ["game.t_max=20", "recorder=none"]
 
@@ -47,6 +50,23 @@ def play(overrides: list[str], seed: int) -> dict:
 
     cfg = compose([*SHORT, *overrides, f"game.seed={seed}"])
     return Game(cfg).play("unused").result
+
+
+def belief_digest() -> str:
+    """sha256 of every tick's particles and weights in a short S-S game: far more sensitive
+    than the measures, which ulp-level differences rarely reach."""
+    import hashlib
+
+    from pegame.config import compose
+    from pegame.game import Game
+
+    loop = Game(compose(["game.t_max=10", "recorder=none", "env=brick"])).start()
+    digest = hashlib.sha256()
+    while not loop.done:
+        loop.advance()
+        digest.update(loop.belief.particles.tobytes())
+        digest.update(loop.belief.weights.tobytes())
+    return digest.hexdigest()
 
 
 def main() -> int:

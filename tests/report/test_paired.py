@@ -11,12 +11,12 @@ import sys
 
 import numpy as np
 import pytest
-from report_fixtures import config_job, sweep_games, write_job
 from scipy.stats import wilcoxon
 
 from pegame import report
 from pegame.report.compare import STATS, parse_compare
 from pegame.report.paired import paired_test
+from pegame.testing.reports import config_job, sweep_games, write_job
 
 SEEDS = range(12)
 

@@ -8,6 +8,7 @@ import math
 import pickle
 import re
 import weakref
+from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,7 @@ from pegame.errors import MapError
 from pegame.grid import OccupancyGrid, load_map, per_grid, save_map
 from pegame.grid.cells import cell_centres
 
-MAPS_DIR = Path(__file__).resolve().parents[1] / "maps"
+MAPS_DIR = Path(str(files("pegame.maps")))
 
 # Image rows top to bottom, and the cells map_server's default trinary mode makes of them:
 # p = (255 - v) / 255; p > 0.65 -> 100, p < 0.196 -> 0, else -1 (205 gives p = 0.19608).

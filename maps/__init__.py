@@ -1,1 +1,0 @@
-"""The paper's maps, installed as the package pegame.maps_data."""
