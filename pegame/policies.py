@@ -11,9 +11,10 @@ env's layout) to an action of :mod:`pegame.envs.actions` (2 numbers (v, w) scale
   which also stores the role and the observation settings and decision period it was
   trained with.
 
-:class:`PolicyPlayer` is what the ``policy`` pursuer and evader strategies delegate to:
-it builds the observation every control tick, exactly as the env does, asks the policy
-for a new action every decision period, clips it to [-1, 1] (a NaN is an error) and
+:class:`PolicyStrategy` is the ``policy`` pursuer and evader (one strategy for both roles,
+:func:`pegame.roles.for_role`); it plays through a :class:`PolicyPlayer`, which builds
+the observation every control tick, exactly as the env does, asks the policy for a new
+action every decision period, clips it to [-1, 1] (a NaN is an error) and
 scales it to (v, w).
 """
 
@@ -28,12 +29,12 @@ from typing import Any
 
 import numpy as np
 
-from pegame.api import Context
+from pegame.api import Context, EvaderObservation, PursuerObservation, Strategy
 from pegame.envs.actions import to_velocity
 from pegame.envs.observations import EvaderFeatures, ObservationSettings, PursuerFeatures
 from pegame.envs.settings import EnvSettings
 from pegame.errors import ConfigError, require
-from pegame.types import Body, Plan, Velocity
+from pegame.types import Body, Plan, Pose, Velocity
 
 #: version of the .npz layout written by save()
 FORMAT = 1
@@ -233,3 +234,27 @@ class PolicyPlayer:
             )
         self.tick += 1
         return self.command
+
+
+class PolicyStrategy(Strategy):
+    """A trained policy (linear .npz or a callable) on its role's env observation; it
+    commands velocities directly and makes no plan."""
+
+    description = (
+        "A learned policy (linear .npz or module:function) on the pegame.envs observation."
+    )
+    #: 'pursuer' or 'evader', set by :func:`pegame.roles.for_role`
+    role: str
+
+    def __init__(self, config: Any, context: Context, rng: np.random.Generator) -> None:
+        super().__init__(config, context, rng)
+        self.player = PolicyPlayer(config, self.role, context)
+
+    def reset(self, pose: Pose) -> None:
+        self.player.reset()
+
+    def decide(self, observation: PursuerObservation | EvaderObservation) -> Plan:
+        return self.player.plan()
+
+    def control(self, observation: PursuerObservation | EvaderObservation) -> Velocity:
+        return self.player.control(observation)

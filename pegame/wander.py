@@ -19,8 +19,14 @@ and Evader"), in the two readings of the paper's text that ``model`` chooses bet
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
+from pegame.api import Context, EvaderObservation, PursuerObservation, Strategy
+from pegame.errors import require
+from pegame.grid import OccupancyGrid
 from pegame.navigation import PathFollower, Planner
 from pegame.types import STOP, Body, Plan, Pose, Velocity
 
@@ -101,7 +107,43 @@ class RandomActions:
 
 
 def random_agent(
-    model: str, grid, body: Body, rng: np.random.Generator
+    model: str, grid: OccupancyGrid, body: Body, rng: np.random.Generator
 ) -> Wanderer | RandomActions:
     """The random behaviour ``model`` (one of :data:`MODELS`) for one agent."""
     return Wanderer(grid, body, rng) if model == "waypoint" else RandomActions(body, rng)
+
+
+@dataclass
+class RandomOptions:
+    """The ``random`` strategies' parameter (on top of the role's body parameters)."""
+
+    model: str = "waypoint"  # waypoint: random reachable goals; action: random (v, w) actions
+
+    def check(self, role: str) -> None:
+        """``model`` is one of :data:`MODELS` (for either role)."""
+        require(self.model in MODELS, "model", " or ".join(MODELS), self.model)
+
+
+class RandomStrategy(Strategy):
+    """The paper's random agent for either role (paper, Sec. "Random Pursuer and Evader"),
+    ``model`` as the module docstring describes; it ignores what it sees. The ``random``
+    pursuer and evader are this behaviour (:func:`pegame.roles.for_role`)."""
+
+    description = (
+        "Baseline: random reachable goals (model=waypoint) or random (v, w) actions (model=action)."
+    )
+    #: 'pursuer' or 'evader', set by :func:`pegame.roles.for_role`
+    role: str
+
+    def __init__(self, config: Any, context: Context, rng: np.random.Generator) -> None:
+        super().__init__(config, context, rng)
+        self.wanderer = random_agent(config.model, context.grid, getattr(context, self.role), rng)
+
+    def reset(self, pose: Pose) -> None:
+        self.wanderer.reset(pose)
+
+    def decide(self, observation: PursuerObservation | EvaderObservation) -> Plan:
+        return self.wanderer.decide(observation.pose)
+
+    def control(self, observation: PursuerObservation | EvaderObservation) -> Velocity:
+        return self.wanderer.control(observation.pose)
