@@ -33,6 +33,7 @@ def run_app(tmp_path: Path, *overrides: str, name: str = "run") -> subprocess.Co
     )
 
 
+@pytest.mark.slow
 def test_one_game_writes_config_result_trajectory_and_log(tmp_path):
     proc = run_app(tmp_path, *FAST, "env=hall", "pursuer=random", "evader=random")
     assert proc.returncode == 0, proc.stderr
@@ -50,6 +51,7 @@ def test_one_game_writes_config_result_trajectory_and_log(tmp_path):
     assert "R-R" in proc.stdout and "hall" in proc.stdout and "tracking rate" in proc.stdout
 
 
+@pytest.mark.slow
 def test_same_seed_gives_byte_identical_files(tmp_path):
     args = (*FAST, "env=enclosed", "game.seed=7")
     for name in ("a", "b"):
@@ -63,6 +65,7 @@ def test_same_seed_gives_byte_identical_files(tmp_path):
     ).read_bytes()
 
 
+@pytest.mark.slow
 def test_any_ros_map_by_absolute_path(tmp_path):
     data = np.zeros((120, 140), dtype=np.int8)
     data[[0, -1], :] = data[:, [0, -1]] = 100
@@ -94,6 +97,7 @@ def test_any_ros_map_by_absolute_path(tmp_path):
         (["env.map=/nonexistent/map.yaml"], "/nonexistent/map.yaml"),
     ],
 )
+@pytest.mark.slow
 def test_bad_input_is_one_clear_error_without_traceback_or_result(tmp_path, overrides, expected):
     proc = run_app(tmp_path, *FAST, *overrides)
     assert proc.returncode == 2
@@ -103,6 +107,7 @@ def test_bad_input_is_one_clear_error_without_traceback_or_result(tmp_path, over
     assert not (tmp_path / "run" / "results.jsonl").exists()  # failed before the first game
 
 
+@pytest.mark.slow
 def test_a_map_with_no_valid_spawn_is_reported(tmp_path):
     data = np.full((20, 20), 100, dtype=np.int8)
     data[8:12, 8:12] = 0  # a 0.2 m pocket: too small for either robot
@@ -117,6 +122,7 @@ def lines(path: Path) -> list[dict]:
     return [json.loads(line) for line in path.read_text().splitlines()]
 
 
+@pytest.mark.slow
 def test_a_game_that_fails_exits_1_and_the_others_are_written(tmp_path):
     # a 1e-5 rad camera finds a spawn for seeds 0-5 but not for seed 6
     proc = run_app(
@@ -128,6 +134,7 @@ def test_a_game_that_fails_exits_1_and_the_others_are_written(tmp_path):
     assert "seed 6 failed: No valid spawn" in proc.stdout  # Hydra logs to stdout
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("launcher", ["joblib", "basic"])
 def test_a_sweep_whose_games_all_fail_exits_1(tmp_path, launcher):
     proc = run_app(
@@ -147,6 +154,7 @@ def test_a_sweep_whose_games_all_fail_exits_1(tmp_path, launcher):
         assert [e["kind"] for e in lines(path)] == ["failed", "summary"]
 
 
+@pytest.mark.slow
 def test_one_bad_cell_of_a_sweep_is_reported_and_the_others_run(tmp_path):
     proc = run_app(
         tmp_path,
@@ -171,6 +179,7 @@ def test_one_bad_cell_of_a_sweep_is_reported_and_the_others_run(tmp_path):
     assert (tmp_path / "sweep" / "table1.md").exists()  # the report ran
 
 
+@pytest.mark.slow
 def test_overrides_are_recorded_with_every_game(tmp_path):
     proc = run_app(tmp_path, *FAST, "env=hall", "pursuer=random")
     assert proc.returncode == 0, proc.stderr
@@ -179,6 +188,7 @@ def test_overrides_are_recorded_with_every_game(tmp_path):
     assert entry["config"]["pursuer"]["name"] == "random"
 
 
+@pytest.mark.slow
 def test_resuming_a_sweep_with_other_cells_is_an_error_naming_the_keys(tmp_path):
     sweep = f"hydra.sweep.dir={tmp_path / 'sweep'}"
     first = run_app(
@@ -209,6 +219,7 @@ def test_resuming_a_sweep_with_other_cells_is_an_error_naming_the_keys(tmp_path)
     assert {p: p.read_bytes() for p in (tmp_path / "sweep").glob("*/results.jsonl")} == before
 
 
+@pytest.mark.slow
 def test_a_job_directory_has_one_writer(tmp_path):
     from pegame.joblock import JobLock
 
@@ -219,6 +230,7 @@ def test_a_job_directory_has_one_writer(tmp_path):
     assert not (tmp_path / "run" / "results.jsonl").exists()
 
 
+@pytest.mark.slow
 def test_a_full_disk_is_one_clear_error_and_the_result_is_printed(tmp_path):
     (tmp_path / "run").mkdir()
     (tmp_path / "run" / "results.jsonl").symlink_to("/dev/full")

@@ -36,6 +36,7 @@ def test_ruff_format_check_finds_nothing_to_reformat():
     assert proc.returncode == 0, proc.stdout + proc.stderr
 
 
+@pytest.mark.slow
 def test_mypy_finds_no_type_errors_in_the_public_api():
     proc = run("mypy")  # the files and settings of [tool.mypy]
     assert proc.returncode == 0, proc.stdout + proc.stderr

@@ -51,10 +51,12 @@ class TestKalman(EstimatorConformance):
     bad_values = {"measurement_std": 0.0}
 
 
+@pytest.mark.slow
 class TestLastSeen(EstimatorConformance):
     plugin = "last_seen"
 
 
+@pytest.mark.slow
 class TestSmartPursuer(PursuerConformance):
     plugin = "smart"
     bad_values = {"radius": -0.2, "standoff": -1.0}
@@ -65,6 +67,7 @@ class TestRandomPursuer(PursuerConformance):
     bad_values = {"w_max": 0.0}
 
 
+@pytest.mark.slow
 class TestPolicyPursuer(PursuerConformance):
     plugin = "policy"
     overrides = (f"pursuer.path={EXAMPLES / 'cem_pursuer.npz'}",)
@@ -91,6 +94,7 @@ class TestNullRecorder(RecorderConformance):
     plugin = "none"
 
 
+@pytest.mark.slow
 class TestRerunRecorder(RecorderConformance):
     plugin = "rerun"
     bad_values = {"jpeg_quality": 0, "trail_every": 0}

@@ -35,6 +35,7 @@ print(json.dumps([[play(cases[g["label"]], g["seed"]) for g in games], belief_di
 """
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"), reason="x86-64 CPU names")
 def test_reference_games_are_the_same_with_kernels_for_a_generic_cpu(tmp_path):
     games = [g for g in json.loads(DATA.read_text()) if g["label"] in LABELS]

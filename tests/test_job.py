@@ -175,6 +175,7 @@ def run_sweep(tmp_path: Path, *overrides: str) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.slow
 def test_multirun_through_joblib_writes_every_job_and_the_report(tmp_path):
     proc = run_sweep(tmp_path)
     assert proc.returncode == 0, proc.stderr
@@ -187,6 +188,7 @@ def test_multirun_through_joblib_writes_every_job_and_the_report(tmp_path):
     assert not list((tmp_path / "sweep").glob(".pegame-status-*"))  # collected and removed
 
 
+@pytest.mark.slow
 def test_multirun_through_submitit_local(tmp_path):
     pytest.importorskip("hydra_plugins.hydra_submitit_launcher")
     proc = run_sweep(tmp_path, "hydra/launcher=submitit_local", "hydra.launcher.timeout_min=5")
@@ -288,6 +290,7 @@ def assert_workers_stop(tmp_path: Path, workers: list[int]) -> None:
     assert games_stored(tmp_path) == stopped  # nothing appends any more
 
 
+@pytest.mark.slow
 def test_kill_9_of_the_sweep_parent_stops_its_workers_and_resume_completes(tmp_path):
     workers = interrupt_mid_sweep(tmp_path, lambda proc: proc.send_signal(signal.SIGKILL))
     assert_workers_stop(tmp_path, workers)
@@ -299,6 +302,7 @@ def test_kill_9_of_the_sweep_parent_stops_its_workers_and_resume_completes(tmp_p
         assert sorted(seeds) == list(range(TRIALS)), path  # every game once: no race, none lost
 
 
+@pytest.mark.slow
 def test_sigterm_of_the_sweep_parent_stops_its_workers(tmp_path):
     def terminate(proc):
         proc.send_signal(signal.SIGTERM)
@@ -308,6 +312,7 @@ def test_sigterm_of_the_sweep_parent_stops_its_workers(tmp_path):
     assert_workers_stop(tmp_path, workers)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sigint_ignored", [False, True], ids=["terminal", "started-ignored"])
 def test_ctrl_c_stops_the_sweep_and_its_workers(tmp_path, sigint_ignored):
     # started-ignored: a sweep launched with SIGINT ignored (in the background, or by a test

@@ -145,6 +145,7 @@ def test_import_pegame_loads_no_plugin():
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
 
 
+@pytest.mark.slow
 def test_plugins_listing_shows_every_plugin_with_its_distribution():
     out = subprocess.run(
         [sys.executable, "-m", "pegame.catalog"], capture_output=True, text=True, check=True

@@ -78,6 +78,7 @@ def listed(run_dir: Path, capsys) -> dict[str, str]:
     return {Path(path).relative_to(run_dir).as_posix(): status for path, _size, status in rows}
 
 
+@pytest.mark.slow
 def test_replay_lists_each_recording_with_its_status(run_dir, capsys):
     assert listed(run_dir, capsys) == {
         "job0/game_0.rrd": "complete",

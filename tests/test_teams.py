@@ -137,6 +137,7 @@ def test_a_heterogeneous_team_plays_one_plugin_per_member_with_its_own_options()
     assert game.play("unused").result["pursuer"] == "random+smart"
 
 
+@pytest.mark.slow
 def test_the_cli_exits_2_on_a_bad_team_value_with_the_allowed_values():
     run = subprocess.run(
         [sys.executable, "-m", "pegame", "team.evaders=-1", "recorder=none"],

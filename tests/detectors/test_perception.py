@@ -98,6 +98,7 @@ def bursts(missed: np.ndarray) -> np.ndarray:
     return lengths[:-1] if missed[-1] else lengths
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("hz", [5.0, 10.0, 20.0])
 def test_bursty_misses_have_the_configured_fraction_and_burst_length_at_any_rate(hz):
     fraction, length, seconds = 0.3, 1.5, 20000.0

@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from pegame.envs.bench import bench_vector_env, format_vector
 
 
+@pytest.mark.slow
 def test_vector_bench_measures_every_figure_in_alternating_rounds():
     report = bench_vector_env(
         seconds=0.2, num_envs=6, smart_envs=2, overrides=["env=enclosed"], single_steps=20

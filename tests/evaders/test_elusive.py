@@ -19,6 +19,7 @@ from pegame.types import Body, Camera, Pose
 from pegame.visibility import body_in_view, visibility_region
 
 
+@pytest.mark.slow
 class TestConformance(EvaderConformance):
     plugin = "elusive"
     bad_values = {

@@ -21,6 +21,7 @@ from pegame.visibility import MaskRegion
 CAMERA = Camera()
 
 
+@pytest.mark.slow
 class TestConformance(PursuerConformance):
     plugin = "anticipating"
     bad_values = {"k_heading": 0, "lead_time": -1, "look_mass": 0, "look_angle_step": 0}

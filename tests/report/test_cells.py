@@ -86,6 +86,7 @@ def test_a_sweep_over_the_estimator_is_reported_and_tested_per_estimator(tmp_pat
     ]
 
 
+@pytest.mark.slow
 def test_settings_that_follow_the_map_or_the_pairing_are_no_extra_factor(tmp_path):
     jobs = 0
     for env in ("enclosed", "brick"):
@@ -148,6 +149,7 @@ def test_duplicates_need_the_same_config_and_seed_and_are_listed(tmp_path):
     assert "seed 2: kept 1 line 1, dropped 0 line 3" in md
 
 
+@pytest.mark.slow
 def test_several_sweep_dirs_are_compared_as_one_study(tmp_path):
     config_job(tmp_path / "a", "0", range(4), [0.9] * 4)
     config_job(tmp_path / "b", "0", range(4), [0.3] * 4, **{"estimator.name": "last_seen"})
@@ -242,6 +244,7 @@ def test_a_cell_mixing_code_versions_or_config_hashes_is_warned(tmp_path, caplog
     assert warning in caplog.text
 
 
+@pytest.mark.slow
 def test_legacy_lines_load_beside_lines_with_config(tmp_path):
     legacy = [game("enclosed", 1.0, "S-R", s, 0.2) for s in range(3)]  # estimator last_seen
     write_job(tmp_path, "0", legacy)

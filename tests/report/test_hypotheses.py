@@ -36,6 +36,7 @@ def tracking_rates(pursuer: str, tmp_path) -> list[float]:
     ]
 
 
+@pytest.mark.slow
 def test_smart_pursuer_tracks_better_than_random(tmp_path):
     smart, random = tracking_rates("smart", tmp_path), tracking_rates("random", tmp_path)
     assert np.mean(smart) - np.mean(random) >= 0.2

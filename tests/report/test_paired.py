@@ -71,6 +71,7 @@ def test_without_common_seeds_the_paired_test_is_not_tested(tmp_path):
     assert unseeded["summary"]["n"] == 2 and unseeded["summary_paired"]["n"] == 0
 
 
+@pytest.mark.slow
 def test_h3_paired_needs_the_smart_evader_tracked_less_and_above_45_percent(tmp_path):
     rng = np.random.default_rng(5)
     base = rng.uniform(0.6, 0.9, len(SEEDS))
@@ -167,6 +168,7 @@ def test_compare_two_values_of_a_factor_cell_by_cell(tmp_path):
     assert "compare_detector.miss_probability.md" in saved["outputs"]
 
 
+@pytest.mark.slow
 def test_compare_matches_cells_within_each_combination_of_the_other_factors(tmp_path):
     for k, estimator in enumerate(("last_seen", "particle_filter")):
         for j, miss in enumerate((0.0, 0.3)):
@@ -206,6 +208,7 @@ def test_compare_names_what_the_sweep_has_when_asked_for_what_it_lacks(tmp_path)
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_cli_compare_writes_the_comparison(tmp_path):
     factor_sweep(tmp_path)
     command = [sys.executable, "-m", "pegame.report", str(tmp_path), "--out", str(tmp_path / "o")]

@@ -154,6 +154,7 @@ def test_figures_are_non_empty_png_and_svg(tmp_path):
     json.loads((tmp_path / "report.json").read_text())
 
 
+@pytest.mark.slow
 def test_cli_writes_the_report_into_out(tmp_path):
     write_job(tmp_path / "sweep", "0", sweep_games(separated("S-R", "R-R", n=5)))
     proc = subprocess.run(
@@ -237,6 +238,7 @@ def test_invalid_cells_are_listed_and_the_others_reported(tmp_path):
     assert f"- job 1: overrides detector.miss_probability=1.5: {error}" in md
 
 
+@pytest.mark.slow
 def test_a_report_that_cannot_be_written_is_one_clear_error(tmp_path, monkeypatch):
     config_job(tmp_path / "sweep", "0", range(2), [0.5, 0.6])
     (tmp_path / "file").write_text("not a directory")

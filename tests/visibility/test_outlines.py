@@ -14,6 +14,7 @@ from pegame.visibility import visibility_region
 from pegame.visibility.outlines import NEAR_ARC_POINTS, free_runs, visibility_outlines
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-0.7, 1.3, 0.4)])
 def test_visibility_outlines_match_their_reference_and_bound_the_region(origin):
     # Sparse walls on a large grid, so that the kernel's jumps over free cells are long.
