@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The team study (docs/teams/README.md): conf/experiment/teams.yaml swept in four parts run
+# The team study (docs/teams/README.md): pegame/conf/experiment/teams.yaml swept in four parts run
 # side by side (one per map), then the report with the paired
 # comparison of the cooperative team against independent copies of the smart pursuer.
 # Writes the games into $OUT (default outputs/teams) and the report into docs/teams/report.
