@@ -19,7 +19,7 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -217,6 +217,8 @@ class TeamTick:
 
 # ----------------------------------------------------------------------- interfaces
 
+PluginT = TypeVar("PluginT", bound="Plugin")
+
 
 class Plugin(ABC):  # noqa: B024 - an abstract base for the interfaces, which add the methods
     """Base of every plugin: holds its validated config, the game context and its RNG.
@@ -235,6 +237,14 @@ class Plugin(ABC):  # noqa: B024 - an abstract base for the interfaces, which ad
         self.config = config
         self.context = context
         self.rng = rng
+
+    @classmethod
+    def narrow(cls: type[PluginT], plugin: Plugin) -> PluginT:
+        """``plugin`` as an instance of this class (an interface: ``Pursuer.narrow(p)``);
+        TypeError for a plugin of another kind."""
+        if not isinstance(plugin, cls):
+            raise TypeError(f"{type(plugin).__name__} is not an instance of {cls.__name__}.")
+        return plugin
 
 
 class Simulator(Plugin):
@@ -386,25 +396,34 @@ def fuse_detections(
     return pursuers[nearest], replace(best, position=(sum(xs) / len(xs), sum(ys) / len(ys)))
 
 
-class Strategy(Plugin):
+#: the observation type a :class:`Strategy` is given
+ObservationT = TypeVar("ObservationT", contravariant=True)
+
+
+class Strategy(Plugin, Generic[ObservationT]):
     """A pursuer or evader policy: a plan at each decision tick, a command at each control
     tick. The game calls ``reset`` once, then ``decide`` every decision period and
-    ``control`` every control period (both with the latest observation)."""
+    ``control`` every control period (both with the latest observation).
+
+    Generic over its observation type: :class:`Pursuer` is a
+    ``Strategy[PursuerObservation]``, :class:`Evader` a ``Strategy[EvaderObservation]``;
+    a behaviour written once for either role is a
+    ``Strategy[PursuerObservation | EvaderObservation]``."""
 
     @abstractmethod
     def reset(self, pose: Pose) -> None:
         """Start a new game at ``pose``."""
 
     @abstractmethod
-    def decide(self, observation: Any) -> Plan:
+    def decide(self, observation: ObservationT) -> Plan:
         """Choose what to do until the next decision (called at decision_hz)."""
 
     @abstractmethod
-    def control(self, observation: Any) -> Velocity:
+    def control(self, observation: ObservationT) -> Velocity:
         """The velocity command for the next control period (called at control_hz)."""
 
 
-class Pursuer(Strategy):
+class Pursuer(Strategy[PursuerObservation]):
     """A pursuer strategy; observations are :class:`PursuerObservation`.
 
     Its body: ``Config.radius`` and ``Config.w_max``; its max speed is not a parameter but
@@ -425,7 +444,7 @@ class Pursuer(Strategy):
                 require(value > 0, key, "a positive number", value)
 
 
-class Evader(Strategy):
+class Evader(Strategy[EvaderObservation]):
     """An evader strategy; observations are :class:`EvaderObservation`.
 
     Its body: ``Config.radius``, ``Config.v_max`` and ``Config.w_max`` (also in

@@ -13,7 +13,7 @@ component, in :data:`STREAMS` order), so the same scenario and seed give the sam
 
 Teams (``team.pursuers``, ``team.evaders``): member 0 of each role, detector pair (0, 0)
 and evader 0's estimator get the 1v1 game's generators; every other member draws from a
-stream spawned after them (:meth:`Game._member_rng`), and the spawn places the 1v1
+stream spawned after them (:meth:`Game._member`), and the spawn places the 1v1
 game's pair first (:func:`spawn_team`), so a 1v1 game is the special case, unchanged.
 """
 
@@ -33,12 +33,23 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from pegame import registry
-from pegame.api import INTERFACES, Context, Tick
+from pegame.api import (
+    INTERFACES,
+    Context,
+    Detector,
+    Estimator,
+    Evader,
+    Plugin,
+    Pursuer,
+    Recorder,
+    Simulator,
+    Tick,
+)
 from pegame.config import EnvConfig, GameConfig, TeamConfig, resolve_map_path, team_members, typed
 from pegame.errors import ConfigError, SpawnError
 from pegame.files import write_atomic
 from pegame.grid import OccupancyGrid, load_map, per_grid, read_only
-from pegame.loop import TickLoop, check_team
+from pegame.loop import GamePlugins, TickLoop, check_team
 from pegame.metrics import TeamMetrics, TrackingMetrics
 from pegame.navigation import Planner
 from pegame.types import Body, Camera, Pose
@@ -236,6 +247,8 @@ def team_header(pursuers: int, evaders: int) -> tuple[str, ...]:
 def team_trajectory_row(t: Tick) -> tuple:
     """A team tick as a row of :func:`team_header`."""
     team = t.team
+    if team is None:
+        raise ValueError("A 1v1 tick has no team row: use trajectory_row.")
     poses = [v for pose in (*team.pursuers, *team.evaders) for v in (pose.x, pose.y, pose.theta)]
     flags = []
     for j in range(len(team.evaders)):
@@ -261,6 +274,15 @@ def check_room_for_team(context: Context, pursuers: int, evaders: int) -> None:
             f"{evaders} evader(s): it has room for {room} bodies of radius {radius} m apart. "
             "Use a smaller team (team.pursuers, team.evaders), a larger map or smaller radii."
         )
+
+
+def plain(node: DictConfig, resolve: bool = False) -> dict[str, Any]:
+    """A config node as plain containers (OmegaConf.to_container), interpolations
+    ``resolve``d or kept."""
+    container = OmegaConf.to_container(node, resolve=resolve)
+    if not isinstance(container, dict):
+        raise TypeError(f"Expected a mapping config node, got {type(container).__name__}.")
+    return {str(key): value for key, value in container.items()}
 
 
 class Scenario:
@@ -307,11 +329,13 @@ class Scenario:
             check_context = getattr(config, "check_context", None)
             if check_context is not None:
                 check_context(self.context)
-        self.config = OmegaConf.to_container(cfg, resolve=True)
+        self.config = plain(cfg, resolve=True)
         self.team = self._team(cfg)
         self.team_size = (len(self.team["pursuer"]), len(self.team["evader"]))
         if self.team_size != (1, 1):
-            check_team(self.classes["sim"], self.classes["detector"], *self.team_size)
+            sim, detector = self.classes["sim"], self.classes["detector"]
+            assert issubclass(sim, Simulator) and issubclass(detector, Detector)  # registry.load
+            check_team(sim, detector, *self.team_size)
             check_room_for_team(self.context, *self.team_size)
 
     def _team(self, cfg: DictConfig) -> dict[str, list[tuple[str, type, Any]]]:
@@ -323,7 +347,7 @@ class Scenario:
         members: dict[str, list[tuple[str, type, Any]]] = {}
         for role in ("pursuer", "evader"):
             body_keys = {f.name for f in fields(INTERFACES[role].Config)}
-            base = {k: v for k, v in OmegaConf.to_container(cfg[role]).items() if k != "name"}
+            base = {k: v for k, v in plain(cfg[role]).items() if k != "name"}
             entries = team_members(getattr(team, f"{role}s"), role)
             members[role] = []
             for index, entry in enumerate(entries):
@@ -386,52 +410,53 @@ class Game:
         self.context = scenario.context
         streams = dict(zip(STREAMS, np.random.SeedSequence(self.seed).spawn(len(STREAMS))))
         self.spawn_rng = np.random.default_rng(streams["spawn"])
-        self.plugins = {
-            kind: scenario.member(kind, 0)[0](
-                scenario.member(kind, 0)[1], self.context, np.random.default_rng(streams[kind])
-            )
-            for kind in INTERFACES
+        one = {
+            kind: self._build(kind, 0, np.random.default_rng(streams[kind])) for kind in INTERFACES
         }
-        self.team = self._members() if scenario.team_size != (1, 1) else None
-
-    def _member_rng(self, kind: str, *index: int) -> np.random.Generator:
-        """The generator of member ``index`` of ``kind`` (a team's extra members): a stream
-        after every 1v1 stream (spawn key ``len(STREAMS)``), so member 0 keeps the 1v1
-        game's generator."""
-        key = (len(STREAMS), STREAMS.index(kind), *index)
-        return np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=key))
-
-    def _members(self) -> dict[str, list]:
-        """The team's plugins by kind, for :class:`pegame.loop.TickLoop`: member 0 of each
-        is the 1v1 plugin, the others are built with their own generators."""
-        scenario, context = self.scenario, self.context
         n, m = scenario.team_size
-        team: dict[str, list] = {}
-        for role in ("pursuer", "evader"):
-            team[role] = [self.plugins[role]] + [
-                cls(config, context, self._member_rng(role, k))
-                for k, (_, cls, config) in enumerate(scenario.team[role])
-                if k > 0
-            ]
-        detector, estimator = scenario.classes["detector"], scenario.classes["estimator"]
-        team["detector"] = [
-            [
-                self.plugins["detector"]
-                if (i, j) == (0, 0)
-                else detector(
-                    scenario.configs["detector"], context, self._member_rng("detector", i, j)
-                )
+        pursuers = (
+            Pursuer.narrow(one["pursuer"]),
+            *(Pursuer.narrow(self._member("pursuer", k, k)) for k in range(1, n)),
+        )
+        evaders = (
+            Evader.narrow(one["evader"]),
+            *(Evader.narrow(self._member("evader", k, k)) for k in range(1, m)),
+        )
+        detector = Detector.narrow(one["detector"])
+        detectors = tuple(
+            tuple(
+                detector if (i, j) == (0, 0) else Detector.narrow(self._member("detector", 0, i, j))
                 for j in range(m)
-            ]
+            )
             for i in range(n)
-        ]
-        team["estimator"] = [
-            self.plugins["estimator"]
-            if j == 0
-            else estimator(scenario.configs["estimator"], context, self._member_rng("estimator", j))
-            for j in range(m)
-        ]
-        return team
+        )
+        estimators = (
+            Estimator.narrow(one["estimator"]),
+            *(Estimator.narrow(self._member("estimator", 0, j)) for j in range(1, m)),
+        )
+        self.plugins = GamePlugins(
+            Simulator.narrow(one["sim"]),
+            detectors,
+            estimators,
+            pursuers,
+            evaders,
+            Recorder.narrow(one["recorder"]),
+        )
+
+    def _build(self, kind: str, member: int, rng: np.random.Generator) -> Plugin:
+        """Member ``member`` of plugin ``kind`` (its class and config from the scenario)
+        built with ``rng``."""
+        cls, config = self.scenario.member(kind, member)
+        return cls(config, self.context, rng)
+
+    def _member(self, kind: str, member: int, *index: int) -> Plugin:
+        """A team's extra member ``member`` of ``kind`` (the detectors' and estimators'
+        class is the kind's own) built with the generator of ``index``: a stream after
+        every 1v1 stream (spawn key ``len(STREAMS)``), so member 0 keeps the 1v1 game's
+        generator."""
+        key = (len(STREAMS), STREAMS.index(kind), *index)
+        rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=key))
+        return self._build(kind, member, rng)
 
     def start(self, external: tuple[str, ...] = (), estimate: bool = True) -> TickLoop:
         """Spawn both agents and return the game's tick loop at tick 0 (see TickLoop)."""
@@ -445,14 +470,13 @@ class Game:
             estimate,
             substeps=settings.substeps,
             turn_order=settings.turn_order,
-            team=self.team,
         )
         loop.start(*spawn_team(self.context, self.spawn_rng, *self.scenario.team_size))
         return loop
 
     def play(self, out_dir: str | Path, recording_name: str = "game") -> Outcome:
         """Play the game; the recorder (if any) writes ``recording_name`` into ``out_dir``."""
-        recorder = self.plugins["recorder"]
+        recorder, solo = self.plugins.recorder, self.scenario.team_size == (1, 1)
         config = {
             **self.scenario.config,
             "game": {**self.scenario.config["game"], "seed": self.seed},
@@ -461,7 +485,7 @@ class Game:
             loop = self.start()
             recorder.start(str(out_dir), recording_name, config)
             trajectory: list[tuple] = []
-            row = trajectory_row if self.team is None else team_trajectory_row
+            row = trajectory_row if solo else team_trajectory_row
             try:
                 for _ in range(loop.ticks - loop.step):
                     trajectory.append(row(loop.advance()))
@@ -471,8 +495,8 @@ class Game:
                 raise
             recorder.finish(result)
         finally:
-            self.plugins["sim"].close()
-        header = TRAJECTORY_HEADER if self.team is None else team_header(*self.scenario.team_size)
+            self.plugins.sim.close()
+        header = TRAJECTORY_HEADER if solo else team_header(*self.scenario.team_size)
         return Outcome(result, trajectory, header)
 
     def _result(self, metrics: TrackingMetrics | TeamMetrics) -> dict[str, Any]:

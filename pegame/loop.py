@@ -54,14 +54,19 @@ lists (:meth:`TickLoop._advance_1v1`).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from typing import TypeGuard
 
 from pegame.api import (
     Context,
+    Detector,
+    Estimator,
+    Evader,
     EvaderObservation,
-    Plugin,
+    Pursuer,
     PursuerObservation,
     PursuerTeam,
+    Recorder,
     Simulator,
     TeamTick,
     Tick,
@@ -69,10 +74,68 @@ from pegame.api import (
 from pegame.config import TURN_ORDERS
 from pegame.errors import ConfigError
 from pegame.metrics import TeamMetrics, TrackingMetrics
-from pegame.types import EMPTY_BELIEF, Belief, Detection, Plan, Pose, SensorFrame, Velocity
+from pegame.types import (
+    EMPTY_BELIEF,
+    STOP,
+    Belief,
+    Detection,
+    Plan,
+    Pose,
+    Region,
+    SensorFrame,
+    Velocity,
+)
 from pegame.visibility import UnionRegion, VisibilityRegion, body_in_view
 
 ROLES = ("pursuer", "evader")
+
+
+@dataclass(frozen=True)
+class GamePlugins:
+    """A game's plugins, one typed field per role: the simulator; ``detectors[i][j]``,
+    pursuer i's detector of evader j; ``estimators[j]``, evader j's; the N ``pursuers``
+    and M ``evaders`` strategies in member order; the recorder. A 1v1 game has one of
+    each (:meth:`one_on_one`); member 0 of each role is also named by its 1v1 property."""
+
+    sim: Simulator
+    detectors: tuple[tuple[Detector, ...], ...]
+    estimators: tuple[Estimator, ...]
+    pursuers: tuple[Pursuer, ...]
+    evaders: tuple[Evader, ...]
+    recorder: Recorder
+
+    @classmethod
+    def one_on_one(
+        cls,
+        sim: Simulator,
+        detector: Detector,
+        estimator: Estimator,
+        pursuer: Pursuer,
+        evader: Evader,
+        recorder: Recorder,
+    ) -> GamePlugins:
+        """The plugins of a game of one pursuer against one evader."""
+        return cls(sim, ((detector,),), (estimator,), (pursuer,), (evader,), recorder)
+
+    @property
+    def detector(self) -> Detector:
+        """Pursuer 0's detector of evader 0."""
+        return self.detectors[0][0]
+
+    @property
+    def estimator(self) -> Estimator:
+        """Evader 0's estimator."""
+        return self.estimators[0]
+
+    @property
+    def pursuer(self) -> Pursuer:
+        """Pursuer 0's strategy."""
+        return self.pursuers[0]
+
+    @property
+    def evader(self) -> Evader:
+        """Evader 0's strategy."""
+        return self.evaders[0]
 
 
 def nearest(poses: Sequence[Pose], to: Pose) -> int:
@@ -86,19 +149,17 @@ def nearest(poses: Sequence[Pose], to: Pose) -> int:
 class TickLoop:
     """Plays the ticks of one game in the order of the module docstring.
 
-    plugins: the game's plugins by kind (``sim``, ``detector``, ...); context: its context;
-    ticks: control ticks in the game; decide_every: control ticks per decision; external:
-    the roles commanded by the caller; estimate: run the estimator and build the region
-    (forced on when the pursuer is a strategy, which needs them); substeps: simulator
-    steps per control tick; turn_order: one of :data:`pegame.config.TURN_ORDERS`.
-    team: the members of a team game by kind: ``pursuer`` (N strategies), ``evader`` (M),
-    ``detector`` (N lists of M: pair (i, j)) and ``estimator`` (M); None for a 1v1 game
-    (``plugins``' own). An external role is commanded with one velocity per member.
+    plugins: the game's plugins (:class:`GamePlugins`, one per member of each role);
+    context: its context; ticks: control ticks in the game; decide_every: control ticks
+    per decision; external: the roles commanded by the caller (with one velocity per
+    member); estimate: run the estimator and build the region (forced on when the
+    pursuer is a strategy, which needs them); substeps: simulator steps per control
+    tick; turn_order: one of :data:`pegame.config.TURN_ORDERS`.
     """
 
     def __init__(
         self,
-        plugins: Mapping[str, Plugin],
+        plugins: GamePlugins,
         context: Context,
         ticks: int,
         decide_every: int,
@@ -106,7 +167,6 @@ class TickLoop:
         estimate: bool = True,
         substeps: int = 1,
         turn_order: str = "simultaneous",
-        team: Mapping[str, Sequence] | None = None,
     ) -> None:
         unknown = sorted(set(external) - set(ROLES))
         if unknown:
@@ -119,25 +179,18 @@ class TickLoop:
                 "the pursuer commands after seeing the evader's move, inside one tick. Use "
                 "game.turn_order=simultaneous with the environments."
             )
-        if turn_order == "evader_first" and type(plugins["sim"]).step_one is Simulator.step_one:
+        if turn_order == "evader_first" and type(plugins.sim).step_one is Simulator.step_one:
             raise ConfigError(
                 f"game.turn_order=evader_first needs a simulator that moves one agent at a "
-                f"time (Simulator.step_one); {type(plugins['sim']).__name__} does not. Use "
+                f"time (Simulator.step_one); {type(plugins.sim).__name__} does not. Use "
                 "game.turn_order=simultaneous, or the grid simulator (sim=grid)."
             )
         if substeps < 1:
             raise ValueError(f"substeps must be a whole number >= 1, got {substeps}.")
-        self.sim, self.recorder = plugins["sim"], plugins["recorder"]
-        team = team or {
-            "pursuer": [plugins["pursuer"]],
-            "evader": [plugins["evader"]],
-            "detector": [[plugins["detector"]]],
-            "estimator": [plugins["estimator"]],
-        }
-        self.pursuer_strategies = list(team["pursuer"])
-        self.evader_strategies = list(team["evader"])
-        self.detectors = [list(row) for row in team["detector"]]
-        self.estimators = list(team["estimator"])
+        # the plugins as attributes of the loop, one lookup away in the ticks
+        self.sim, self.recorder = plugins.sim, plugins.recorder
+        self.pursuer_strategies, self.evader_strategies = plugins.pursuers, plugins.evaders
+        self.detectors, self.estimators = plugins.detectors, plugins.estimators
         self.n_pursuers, self.n_evaders = len(self.pursuer_strategies), len(self.evader_strategies)
         self.solo = self.n_pursuers == 1 and self.n_evaders == 1
         check_team(type(self.sim), type(self.detectors[0][0]), self.n_pursuers, self.n_evaders)
@@ -148,11 +201,13 @@ class TickLoop:
         self.estimate = estimate or "pursuer" not in self.external
         self.substeps = substeps
         self.turn_order = turn_order
-        self.metrics: TrackingMetrics | TeamMetrics = (
-            TrackingMetrics(context.control_dt)
-            if self.solo
-            else TeamMetrics(context, self.n_pursuers, self.n_evaders)
-        )
+        # the game's measures; a 1v1 game's ticks add to them as ``tracking``, a team's
+        # as ``team_metrics`` (each defined only in its kind of game)
+        self.metrics: TrackingMetrics | TeamMetrics
+        if self.solo:
+            self.tracking = self.metrics = TrackingMetrics(context.control_dt)
+        else:
+            self.team_metrics = self.metrics = TeamMetrics(context, self.n_pursuers, self.n_evaders)
         self.step = 0
         self.time = 0.0  # s, simulation time of the current tick: step * control_dt
         self.evader_first = turn_order == "evader_first"
@@ -225,13 +280,14 @@ class TickLoop:
         for row in self.detectors:
             for detector in row:
                 detector.reset()
-        for strategy, pose in zip(self.pursuer_strategies, pursuers):
-            strategy.reset(pose)
-        for strategy, pose in zip(self.evader_strategies, evaders):
-            strategy.reset(pose)
+        for pursuer_strategy, pose in zip(self.pursuer_strategies, pursuers):
+            pursuer_strategy.reset(pose)
+        for evader_strategy, pose in zip(self.evader_strategies, evaders):
+            evader_strategy.reset(pose)
         if self.evader_first:
             self.pursuers, self.evaders = pursuers, evaders
             self.regions: tuple[VisibilityRegion | None, ...] = (None,) * self.n_pursuers
+            self.union: Region | None = None
         else:
             self._sense()
 
@@ -252,11 +308,10 @@ class TickLoop:
         self.union = None
         self.beliefs: tuple[Belief, ...] = (EMPTY_BELIEF,) * self.n_evaders
         if self.estimate:
-            self.regions = regions or tuple(
-                VisibilityRegion(grid, pose, camera) for pose in self.pursuers
-            )
-            self.union = self.regions[0] if self.n_pursuers == 1 else UnionRegion(self.regions)
-            self.beliefs = tuple(self._estimate(j) for j in range(self.n_evaders))
+            built = regions or tuple(VisibilityRegion(grid, pose, camera) for pose in self.pursuers)
+            union = built[0] if self.n_pursuers == 1 else UnionRegion(built)
+            self.regions, self.union = built, union
+            self.beliefs = tuple(self._estimate(j, built[0], union) for j in range(self.n_evaders))
         self.in_views = tuple(
             tuple(body_in_view(grid, camera, p, (e.x, e.y), radius) for e in self.evaders)
             for p in self.pursuers
@@ -283,34 +338,31 @@ class TickLoop:
         self.detections, self.regions, self.union = ((detection,),), (region,), region
         self.beliefs, self.in_views = (belief,), ((seen,),)
 
-    def _estimate(self, j: int) -> Belief:
-        """Evader j's estimator, reset at tick 0 and updated after, by every pursuer."""
+    def _estimate(self, j: int, region: Region, union: Region) -> Belief:
+        """Evader j's estimator, reset at tick 0 and updated after, by every pursuer;
+        ``region``: pursuer 0's region, ``union``: the union of the pursuers' regions."""
         estimator = self.estimators[j]
         if self.n_pursuers == 1:  # the 1v1 interface: one pursuer, its region
-            pursuer, detection, region = self.pursuers[0], self.detections[0][j], self.regions[0]
+            pursuer, detection = self.pursuers[0], self.detections[0][j]
             if self.step == 0:
                 return estimator.reset(pursuer, detection, region)
             return estimator.update(self.context.control_dt, pursuer, detection, region)
         detections = [row[j] for row in self.detections]
         if self.step == 0:
-            return estimator.reset_team(self.pursuers, detections, self.union)
-        return estimator.update_team(self.context.control_dt, self.pursuers, detections, self.union)
+            return estimator.reset_team(self.pursuers, detections, union)
+        return estimator.update_team(self.context.control_dt, self.pursuers, detections, union)
 
     def pursuer_observation(self, i: int = 0) -> PursuerObservation:
         """What pursuer ``i`` is given at this tick (needs ``estimate``)."""
         j = i % self.n_evaders
+        regions, union = self.regions, self.union
+        if not _built(regions) or union is None:
+            raise RuntimeError("A pursuer's observation needs its region: estimate=True.")
         team = None
         if not self.solo:
-            team = PursuerTeam(
-                i, j, self.pursuers, self.detections, self.beliefs, self.regions, self.union
-            )
+            team = PursuerTeam(i, j, self.pursuers, self.detections, self.beliefs, regions, union)
         return PursuerObservation(
-            self.time,
-            self.pursuers[i],
-            self.detections[i][j],
-            self.beliefs[j],
-            self.regions[i],
-            team,
+            self.time, self.pursuers[i], self.detections[i][j], self.beliefs[j], regions[i], team
         )
 
     def evader_observation(self, j: int = 0) -> EvaderObservation:
@@ -337,19 +389,18 @@ class TickLoop:
             # follows, since the pursuers do not move in the evaders' turn).
             self.pursuers, self.evaders = self.sim.team_poses
             grid, camera = self.context.grid, self.context.camera
-            self.regions = tuple(VisibilityRegion(grid, pose, camera) for pose in self.pursuers)
-            self.union = self.regions[0] if self.n_pursuers == 1 else UnionRegion(self.regions)
-            e_obs = [self.evader_observation(j) for j in range(self.n_evaders)]
+            regions = tuple(VisibilityRegion(grid, pose, camera) for pose in self.pursuers)
+            self.regions = regions
+            self.union = regions[0] if self.n_pursuers == 1 else UnionRegion(regions)
+            first = [self.evader_observation(j) for j in range(self.n_evaders)]
             if deciding:
-                self.evader_plans = [s.decide(o) for s, o in zip(evaders, e_obs)]
-            commanded["evader"] = [s.control(o) for s, o in zip(evaders, e_obs)]
+                self.evader_plans = [s.decide(o) for s, o in zip(evaders, first)]
+            commanded["evader"] = [s.control(o) for s, o in zip(evaders, first)]
             self._integrate(evaders=commanded["evader"])
-            self._sense(self.regions)
-            e_obs = None
-        elif "evader" not in self.external:
+            self._sense(regions)
+        e_obs: list[EvaderObservation] | None = None
+        if not self.evader_first and "evader" not in self.external:
             e_obs = [self.evader_observation(j) for j in range(self.n_evaders)]
-        else:
-            e_obs = None
         p_obs = (
             [self.pursuer_observation(i) for i in range(self.n_pursuers)]
             if "pursuer" not in self.external
@@ -367,7 +418,7 @@ class TickLoop:
         p_cmds, e_cmds = commanded["pursuer"], commanded["evader"]
         in_view = self.in_views[0][0] if self.solo else self.in_view
         if self.solo:
-            self.metrics.add(
+            self.tracking.add(
                 self.pursuers[0],
                 self.evaders[0],
                 self.detections[0][0] is not None,
@@ -375,7 +426,7 @@ class TickLoop:
                 self.beliefs[0],
             )
         else:
-            self.metrics.add(
+            self.team_metrics.add(
                 self.pursuers,
                 self.evaders,
                 self.detections,
@@ -435,6 +486,7 @@ class TickLoop:
         if "evader" not in self.external:
             e_obs = EvaderObservation(time, evader, pursuer, region, self.pursuers, 0)
         if "pursuer" not in self.external:
+            assert region is not None  # a strategy pursuer turns the estimate on (__init__)
             p_obs = PursuerObservation(time, pursuer, detection, belief, region, None)
         if self.step % self.decide_every == 0:  # the evader first, then the pursuer (paper)
             if e_obs is not None:
@@ -448,7 +500,7 @@ class TickLoop:
         if e_obs is not None:
             e_cmd = evader_strategy.control(e_obs)
         in_view = self.in_views[0][0]
-        self.metrics.add(pursuer, evader, detection is not None, in_view, belief)
+        self.tracking.add(pursuer, evader, detection is not None, in_view, belief)
         tick = Tick(
             self.step,
             time,
@@ -473,8 +525,8 @@ class TickLoop:
 
     def _external_1v1(
         self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None
-    ) -> tuple[Velocity | None, Velocity | None]:
-        """The (pursuer, evader) commands of the external roles of a 1v1 game (None for a
+    ) -> tuple[Velocity, Velocity]:
+        """The (pursuer, evader) commands of the external roles of a 1v1 game (STOP for a
         role its strategy commands), as :meth:`_commanded` reads them."""
         commands = commands or {}
         pursuer, evader = commands.get("pursuer"), commands.get("evader")
@@ -482,11 +534,7 @@ class TickLoop:
             "evader" in self.external and evader is None
         ):
             self._commanded(commands)  # raises, naming the missing roles
-        if pursuer is not None and not isinstance(pursuer, Velocity):
-            pursuer = pursuer[0]
-        if evader is not None and not isinstance(evader, Velocity):
-            evader = evader[0]
-        return pursuer, evader
+        return _one(pursuer), _one(evader)
 
     def _next_tick(self) -> None:
         self.step += 1
@@ -529,6 +577,18 @@ class TickLoop:
                 sim.step_team_one("evader", evaders, dt)
 
 
+def _one(command: Velocity | Sequence[Velocity] | None) -> Velocity:
+    """A 1v1 role's command given as a velocity or as a sequence of one; STOP for None."""
+    if command is None:
+        return STOP
+    return command if isinstance(command, Velocity) else command[0]
+
+
+def _built(regions: tuple[VisibilityRegion | None, ...]) -> TypeGuard[tuple[VisibilityRegion, ...]]:
+    """Whether every pursuer's region was built this tick (``estimate``)."""
+    return all(region is not None for region in regions)
+
+
 def _identified(detection: Detection | None, evader: int) -> Detection | None:
     """``detection`` naming evader ``evader`` (a team detector pair knows whom it saw)."""
     if detection is None or detection.evader == evader:
@@ -536,7 +596,7 @@ def _identified(detection: Detection | None, evader: int) -> Detection | None:
     return replace(detection, evader=evader)
 
 
-def check_team(sim: type, detector: type, pursuers: int, evaders: int) -> None:
+def check_team(sim: type[Simulator], detector: type[Detector], pursuers: int, evaders: int) -> None:
     """ConfigError unless the simulator and detector classes can play N ``pursuers``
     against M ``evaders``: a simulator that holds teams, and, against several evaders, a
     detector that tells them apart."""

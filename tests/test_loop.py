@@ -98,3 +98,22 @@ def test_turns_and_teams_take_the_general_tick():
     assert not turns.start().one_on_one
     team = Game(compose(["recorder=none", "game.t_max=2", "team.pursuers=2"]))
     assert not team.start().one_on_one
+
+
+def test_a_pursuer_observation_without_the_regions_is_refused():
+    """With an external pursuer and ``estimate=False`` no region is built: an observation
+    would carry None where its region belongs."""
+    loop = Game(compose(["recorder=none", "game.t_max=2"])).start(("pursuer",), estimate=False)
+    assert loop.region is None
+    with pytest.raises(RuntimeError, match="estimate=True"):
+        loop.pursuer_observation(0)
+
+
+def test_the_loop_plays_the_games_plugins_member_by_member():
+    game = Game(compose(["recorder=none", "game.t_max=2", "team.pursuers=2"]))
+    plugins, loop = game.plugins, game.start()
+    assert plugins.pursuer is plugins.pursuers[0] and len(plugins.pursuers) == 2
+    assert (
+        plugins.detector is plugins.detectors[0][0] and plugins.estimator is plugins.estimators[0]
+    )
+    assert loop.sim is plugins.sim and loop.pursuer_strategies == plugins.pursuers

@@ -121,7 +121,7 @@ def test_the_strategy_holds_its_action_for_the_decision_period():
 
 
 def game_with_policy(cfg):
-    return Game(cfg).plugins["pursuer"]
+    return Game(cfg).plugins.pursuer
 
 
 def observation_at(pursuer, tick):

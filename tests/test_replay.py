@@ -27,7 +27,7 @@ KILLED_GAME = textwrap.dedent("""
     from pegame.game import Game
 
     game = Game(compose({overrides!r}))
-    decide, calls = game.plugins["pursuer"].decide, []
+    decide, calls = game.plugins.pursuer.decide, []
 
     def killed(observation):
         calls.append(observation.time)
@@ -35,7 +35,7 @@ KILLED_GAME = textwrap.dedent("""
             os.kill(os.getpid(), signal.SIGKILL)
         return decide(observation)
 
-    game.plugins["pursuer"].decide = killed
+    game.plugins.pursuer.decide = killed
     game.play(sys.argv[1], "game_2")
 """)
 
@@ -57,7 +57,7 @@ def run_dir(tmp_path_factory):
     def broken(observation):
         raise RuntimeError("pursuer broke")
 
-    game.plugins["pursuer"].decide = broken
+    game.plugins.pursuer.decide = broken
     with pytest.raises(RuntimeError):
         game.play(root / "job1", "game_1")
     script = KILLED_GAME.format(overrides=[*SHORT, "recorder.flush_every=10"])

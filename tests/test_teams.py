@@ -16,7 +16,14 @@ from pegame.config import compose
 from pegame.detectors.oracle import OracleDetector
 from pegame.errors import ConfigError, SpawnError, require
 from pegame.estimators.kalman import KalmanEstimator
-from pegame.game import Game, spawn, spawn_team, team_header, write_outcome
+from pegame.game import (
+    Game,
+    spawn,
+    spawn_team,
+    team_header,
+    team_trajectory_row,
+    write_outcome,
+)
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid, save_map
 from pegame.loop import check_team
 from pegame.metrics import TeamMetrics, TrackingMetrics
@@ -49,11 +56,12 @@ def test_member_zero_of_a_team_gets_the_1v1_generators_and_the_others_their_own(
     team = team_game("team.pursuers=3", "team.evaders=2")
     for kind in ("pursuer", "evader", "detector", "estimator", "sim"):
         assert (
-            team.plugins[kind].rng.bit_generator.state == solo.plugins[kind].rng.bit_generator.state
+            getattr(team.plugins, kind).rng.bit_generator.state
+            == getattr(solo.plugins, kind).rng.bit_generator.state
         )
-    states = [p.rng.bit_generator.state["state"]["state"] for p in team.team["pursuer"]]
+    states = [p.rng.bit_generator.state["state"]["state"] for p in team.plugins.pursuers]
     detectors = [
-        d.rng.bit_generator.state["state"]["state"] for row in team.team["detector"] for d in row
+        d.rng.bit_generator.state["state"]["state"] for row in team.plugins.detectors for d in row
     ]
     assert len(set(states)) == 3 and len(set(detectors)) == 6
 
@@ -131,8 +139,8 @@ def test_a_check_written_under_its_group_is_moved_under_the_node():
 
 def test_a_heterogeneous_team_plays_one_plugin_per_member_with_its_own_options():
     game = team_game("team.pursuers=[random,{name:smart,standoff:1.0}]", "pursuer=smart")
-    first, second = game.team["pursuer"]
-    assert type(first).__name__ == "RandomPursuer" and game.plugins["pursuer"] is first
+    first, second = game.plugins.pursuers
+    assert type(first).__name__ == "RandomPursuer" and game.plugins.pursuer is first
     assert type(second).__name__ == "SmartPursuer" and second.config.standoff == 1.0
     assert game.play("unused").result["pursuer"] == "random+smart"
 
@@ -270,6 +278,12 @@ def test_handoffs_count_custody_passing_from_pursuer_to_pursuer(solo):
     assert summary["tracking_rate_per_pursuer"] == [pytest.approx(0.6), pytest.approx(0.4)]
 
 
+def test_a_1v1_tick_has_no_team_row():
+    tick = team_game().start().advance()
+    with pytest.raises(ValueError, match="no team row"):
+        team_trajectory_row(tick)
+
+
 def test_a_team_game_writes_every_agent_and_the_team_measures(tmp_path):
     game = team_game("team.pursuers=2", "team.evaders=2", "pursuer=cooperative", seed=2)
     outcome = game.play(tmp_path)
@@ -302,7 +316,7 @@ def test_weighted_kmeans_finds_two_separated_clouds_and_their_weights():
 def test_cooperative_pursuers_split_between_the_clusters_of_a_lost_evader():
     game = team_game("team.pursuers=2", "pursuer=cooperative")
     loop = game.start()
-    member = game.team["pursuer"][0]
+    member = game.plugins.pursuers[0]
     cloud = np.vstack([np.tile([3.0, 3.0, 0.0], (500, 1)), np.tile([12.0, 12.0, 0.0], (500, 1))])
     belief = Belief(mean=(7.5, 7.5), particles=cloud, weights=np.full(1000, 1e-3))
     team = loop.pursuer_observation(0).team
@@ -321,7 +335,7 @@ def test_cooperative_pursuers_split_between_the_clusters_of_a_lost_evader():
 
 
 def test_the_team_evader_hides_from_the_nearest_pursuer_of_each_candidate(solo):
-    evader = solo.plugins["evader"]
+    evader = solo.plugins.evader
     me, a = Pose(4.0, 4.0), Pose(6.0, 6.0, 0.5)
     alone = evader.team_escape(me, (a, a))
     reference = evader.search.escape_reference(me, a)

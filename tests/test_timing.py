@@ -5,6 +5,7 @@ the paper's turn order (``game.turn_order=evader_first``), all off by default.""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -60,7 +61,7 @@ def constant_game(overrides, pursuer=STRAIGHT, evader=ARC):
     ):
         strategy = cls(cls.Config(), game.context, np.random.default_rng(0))
         strategy.command = command
-        game.plugins[role] = strategy
+        game.plugins = replace(game.plugins, **{f"{role}s": (strategy,)})
     return game
 
 
@@ -208,7 +209,7 @@ def test_evader_first_the_pursuer_sees_the_evaders_move_and_the_evader_the_pursu
     loop = game.start()
     dt = game.context.control_dt
     ticks = [loop.advance() for _ in range(loop.ticks)]
-    pursuer, evader = game.plugins["pursuer"], game.plugins["evader"]
+    pursuer, evader = game.plugins.pursuer, game.plugins.evader
     for k, tick in enumerate(ticks):
         e_obs, p_obs = evader.seen[k], pursuer.seen[k]
         # the evader moved first, the pursuer paused: the tick shows both after that move
@@ -226,7 +227,7 @@ def test_simultaneous_moves_are_sensed_before_both_move():
     game = constant_game(["game.t_max=3"])
     loop = game.start()
     ticks = [loop.advance() for _ in range(loop.ticks)]
-    evader = game.plugins["evader"]
+    evader = game.plugins.evader
     for k, tick in enumerate(ticks):
         assert evader.seen[k].pose == tick.evader and evader.seen[k].pursuer == tick.pursuer
 
@@ -255,7 +256,7 @@ def test_evader_first_refuses_external_roles_and_sims_without_step_one():
         def sense(self, time):
             return self.inner.sense(time)
 
-    game.plugins["sim"] = BothOnly(game.plugins["sim"])
+    game.plugins = replace(game.plugins, sim=BothOnly(game.plugins.sim))
     with pytest.raises(ConfigError, match="step_one"):
         game.start()
 

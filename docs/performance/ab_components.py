@@ -68,7 +68,8 @@ def worker() -> None:
     def instrumented(overrides: list[str]) -> Game:
         game = Game(compose(["recorder=none", *overrides]))
         for kind, methods in WRAPPED.items():
-            plugin = game.plugins[kind]
+            plugins = game.plugins  # by kind before GamePlugins, a role per field since
+            plugin = plugins[kind] if isinstance(plugins, dict) else getattr(plugins, kind)
             for method in methods:
                 setattr(plugin, method, timed(getattr(plugin, method), f"{kind}.{method}"))
         return game

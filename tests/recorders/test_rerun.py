@@ -229,7 +229,7 @@ def rrd_verify(path: Path) -> subprocess.CompletedProcess:
 
 def failing_at_decision(game: Game, count: int, error: BaseException) -> None:
     """Make the game's pursuer raise ``error`` at its ``count``-th decision."""
-    decide, calls = game.plugins["pursuer"].decide, []
+    decide, calls = game.plugins.pursuer.decide, []
 
     def failing(observation):
         calls.append(observation.time)
@@ -237,7 +237,7 @@ def failing_at_decision(game: Game, count: int, error: BaseException) -> None:
             raise error
         return decide(observation)
 
-    game.plugins["pursuer"].decide = failing
+    game.plugins.pursuer.decide = failing
 
 
 @pytest.fixture(scope="module")

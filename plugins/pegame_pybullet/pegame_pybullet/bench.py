@@ -127,7 +127,7 @@ def visibility_agreement(
             ]
             played = Game(compose(["sim=grid", "detector=oracle", *base])).play(out)
             game = Game(compose(["sim=pybullet", "detector=segmentation", *base]))
-            sim, detector, context = game.plugins["sim"], game.plugins["detector"], game.context
+            sim, detector, context = game.plugins.sim, game.plugins.detector, game.context
             try:
                 for row in played.trajectory:
                     p, e = Pose(*row[2:5]), Pose(*row[5:8])

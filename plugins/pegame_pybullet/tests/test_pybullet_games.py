@@ -30,7 +30,7 @@ def test_a_short_smart_game_runs_end_to_end_and_is_recorded(tmp_path):
     assert result["sim"] == "pybullet" and result["detector"] == "segmentation"
     assert result["ticks"] == 50 and len(outcome.trajectory) == 50
     assert result["tracking_rate"] > 0.5  # the evader spawns in view
-    assert game.plugins["sim"]._client is None  # the physics server is released
+    assert game.plugins.sim._client is None  # the physics server is released
     assert (tmp_path / "game.rrd").stat().st_size > 0
     write_outcome(outcome, tmp_path)
     assert json.loads((tmp_path / "result.json").read_text())["pairing"] == "S-S"

@@ -24,11 +24,13 @@ from __future__ import annotations
 import math
 import tempfile
 from collections.abc import Iterable, Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from pegame import registry
+from pegame.api import Detector
 from pegame.config import compose
 from pegame.game import Game
 from pegame.types import BoundingBox, Detection, Pose, SensorFrame
@@ -43,11 +45,12 @@ def iou(a: BoundingBox, b: BoundingBox) -> float:
     return inter / union if union > 0 else 0.0
 
 
-class _Judge:
+class _Judge(Detector):
     """Stands in for the game's detector: returns the reference's detection and records,
     per frame, the vision detector's beside it."""
 
     def __init__(self, reference, vision, sim, max_range: float, min_visible: float) -> None:
+        super().__init__(reference.config, reference.context, reference.rng)
         self.reference, self.vision, self.sim = reference, vision, sim
         self.max_range, self.min_visible = max_range, min_visible
         self.rows: list[tuple[str, Detection | None, Detection | None, Pose]] = []
@@ -108,9 +111,9 @@ def evaluate(
             )
             detector = vision_cls(vision_config, game.context, np.random.default_rng(seed))
             judge = _Judge(
-                game.plugins["detector"], detector, game.plugins["sim"], max_range, min_visible
+                game.plugins.detector, detector, game.plugins.sim, max_range, min_visible
             )
-            game.plugins["detector"] = judge
+            game.plugins = replace(game.plugins, detectors=((judge,),))
             game.play(out)
             rows += judge.rows
     return _score(rows, iou_threshold)
