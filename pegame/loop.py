@@ -534,7 +534,15 @@ class TickLoop:
             "evader" in self.external and evader is None
         ):
             self._commanded(commands)  # raises, naming the missing roles
-        return _one(pursuer), _one(evader)
+        if pursuer is None:
+            pursuer = STOP
+        elif not isinstance(pursuer, Velocity):
+            pursuer = pursuer[0]
+        if evader is None:
+            evader = STOP
+        elif not isinstance(evader, Velocity):
+            evader = evader[0]
+        return pursuer, evader
 
     def _next_tick(self) -> None:
         self.step += 1
@@ -575,13 +583,6 @@ class TickLoop:
                 sim.step_team_one("pursuer", pursuers, dt)
             elif evaders is not None:
                 sim.step_team_one("evader", evaders, dt)
-
-
-def _one(command: Velocity | Sequence[Velocity] | None) -> Velocity:
-    """A 1v1 role's command given as a velocity or as a sequence of one; STOP for None."""
-    if command is None:
-        return STOP
-    return command if isinstance(command, Velocity) else command[0]
 
 
 def _built(regions: tuple[VisibilityRegion | None, ...]) -> TypeGuard[tuple[VisibilityRegion, ...]]:
