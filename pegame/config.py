@@ -14,18 +14,16 @@ import difflib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, make_dataclass
-from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any, get_type_hints
 
-from hydra.core.config_search_path import ConfigSearchPath
 from hydra.core.config_store import ConfigStore
 from hydra.core.plugins import Plugins
-from hydra.plugins.search_path_plugin import SearchPathPlugin
 from omegaconf import MISSING, DictConfig, OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from pegame.api import PLUGIN_KINDS
+from pegame.defaults import PluginOptionSource, PluginSearchPath
 from pegame.errors import ConfigError, require
 from pegame.types import Camera
 
@@ -223,22 +221,13 @@ def did_you_mean(word: str, choices: Sequence[str]) -> str:
     return f" Did you mean '{close[0]}'?" if close else ""
 
 
-class PluginConfigSearchPath(SearchPathPlugin):
-    """Lets plugin distributions contribute config files: a distribution names the package
-    holding its ``<group>/<name>.yaml`` files under the entry-point group
-    ``pegame.configs`` (``spinner = "spinner.conf"``), and Hydra finds them as it finds
-    pegame's own, so ``python -m pegame pursuer=spinner`` needs no extra flag."""
-
-    def manipulate_search_path(self, search_path: ConfigSearchPath) -> None:
-        for point in sorted(entry_points(group="pegame.configs"), key=lambda p: p.name):
-            search_path.append(provider=f"pegame-plugin-{point.name}", path=f"pkg://{point.value}")
-
-
 def register_schema() -> None:
     """Make the schema available to config.yaml's defaults list as ``pegame_schema`` and
-    add the plugin distributions' config packages to Hydra's search path."""
+    read the config packages, pegame's and the plugin distributions', with each plugin
+    option over its plugin's Config defaults (:mod:`pegame.defaults`)."""
     ConfigStore.instance().store(name="pegame_schema", node=Schema)
-    Plugins.instance().register(PluginConfigSearchPath)
+    Plugins.instance().register(PluginOptionSource)
+    Plugins.instance().register(PluginSearchPath)
 
 
 def resolve_map_path(map_path: str, base_dir: str | Path | None = None) -> Path:

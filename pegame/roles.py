@@ -51,7 +51,7 @@ def for_role(
     config: type = dataclass(
         type(
             "Config",
-            (body, options),
+            (options, body),
             {
                 "__post_init__": __post_init__,
                 "__module__": module,

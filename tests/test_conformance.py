@@ -13,7 +13,6 @@ from pegame import registry
 from pegame.api import Pursuer, Velocity
 from pegame.errors import require
 from pegame.pursuers.random import RandomPursuer
-from pegame.pursuers.smart import SmartPursuer
 from pegame.testing import (
     ConformanceError,
     DetectorConformance,
@@ -23,7 +22,6 @@ from pegame.testing import (
     RecorderConformance,
     SimulatorConformance,
     check_config_errors,
-    check_config_file,
     check_interface,
     check_plugin,
     check_same_seed_same_game,
@@ -221,19 +219,6 @@ def test_a_plugin_reseeding_the_global_generator_is_refused(registered):
         check_same_seed_same_game(
             "pursuer", "random", ["pursuer.name=reseeding", "~pursuer.model"], t_max=2.0
         )
-
-
-class Shifted(SmartPursuer):
-    """The smart pursuer with a default that its config file does not hold."""
-
-    @dataclass
-    class Config(SmartPursuer.Config):
-        standoff: float = 2.0  # m
-
-
-def test_a_config_file_that_does_not_hold_the_defaults_is_refused():
-    with pytest.raises(ConformanceError, match="standoff"):
-        check_config_file("pursuer", Shifted, "smart")
 
 
 def test_check_plugin_runs_every_rule_on_a_built_in():

@@ -1,52 +1,50 @@
-"""One source for each default: every plugin's ``Config`` dataclass is the source, and each
-config file (``conf/<group>/<name>.yaml`` of pegame, of the plugin distributions and of the
-example) repeats it exactly: the same keys, the same values of the same types, the same
-comment per field, and ``name:`` equal to the file stem and to the entry-point name in the
-distribution's pyproject.toml. The body nodes of conf/config.yaml repeat ``Pursuer.Config``
-and ``Evader.Config``, and its game and camera nodes ``GameConfig`` and ``Camera``."""
+"""One source for each default (pegame.defaults): a plugin's ``Config`` dataclass holds its
+defaults, its config file ``<group>/<name>.yaml`` only ``name:`` and what differs, and
+Hydra composes the node from both; conf/config.yaml holds choices, no values of the
+game, camera, team or bodies (their dataclasses give them)."""
 
 from __future__ import annotations
 
 import dataclasses
-import importlib
-import inspect
-import io
-import re
-import textwrap
-import tokenize
 from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
+from omegaconf import OmegaConf
 
+from pegame import defaults, registry
 from pegame.api import INTERFACES
-from pegame.config import GameConfig
+from pegame.config import GameConfig, TeamConfig, compose
+from pegame.errors import ConfigError
+from pegame.game import Game
+from pegame.pursuers.smart import SmartPursuer
 from pegame.registry import GROUPS
+from pegame.testing import ConformanceError, check_config_file
 from pegame.types import Camera
 
 tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
 
 ROOT = Path(__file__).resolve().parents[1]
-#: distribution directory -> its config root (pegame's conf/ is the package pegame.conf)
-DISTRIBUTIONS = {
-    ROOT: ROOT / "pegame" / "conf",
-    ROOT / "plugins" / "pegame_pybullet": None,
-    ROOT / "plugins" / "pegame_vision": None,
-    ROOT / "examples" / "pegame_spinner": None,
-}
+#: the distributions with plugins: pegame, the two plugin distributions and the example
+DISTRIBUTIONS = [
+    ROOT,
+    ROOT / "plugins" / "pegame_pybullet",
+    ROOT / "plugins" / "pegame_vision",
+    ROOT / "examples" / "pegame_spinner",
+]
 GROUP_OF = {entry_group: group for group, entry_group in GROUPS.items()}
 
 
 def project_of(dist: Path) -> dict[str, Any]:
     """The [project] table of a distribution's pyproject.toml."""
-    return tomllib.loads((dist / "pyproject.toml").read_text())["project"]
+    project: dict[str, Any] = tomllib.loads((dist / "pyproject.toml").read_text())["project"]
+    return project
 
 
 def config_root(dist: Path) -> Path:
-    """Where a distribution's ``<group>/<name>.yaml`` files live: its pegame.configs package."""
-    if DISTRIBUTIONS[dist] is not None:
-        return DISTRIBUTIONS[dist]
+    """Where a distribution's ``<group>/<name>.yaml`` files live."""
+    if dist == ROOT:
+        return ROOT / "pegame" / "conf"
     (package,) = project_of(dist)["entry-points"]["pegame.configs"].values()
     return dist.joinpath(*package.split("."))
 
@@ -55,8 +53,7 @@ def options() -> list[tuple[Path, str, str, str]]:
     """(distribution dir, group, name, "module:Class") of every registered plugin."""
     found = []
     for dist in DISTRIBUTIONS:
-        project = project_of(dist)
-        for entry_group, points in project.get("entry-points", {}).items():
+        for entry_group, points in project_of(dist).get("entry-points", {}).items():
             if entry_group in GROUP_OF:
                 found += [
                     (dist, GROUP_OF[entry_group], name, target) for name, target in points.items()
@@ -71,91 +68,34 @@ def option_id(option: tuple[Path, str, str, str]) -> str:
     return f"{option[0].name}:{option[1]}={option[2]}"
 
 
-def import_plugin(dist: Path, target: str, monkeypatch) -> type:
-    """The class ``module:Class`` of a distribution, skipping when a dependency is missing."""
-    monkeypatch.syspath_prepend(str(dist))  # the example is not installed
-    module, _, name = target.partition(":")
-    try:
-        return getattr(importlib.import_module(module), name)
-    except ImportError as exc:
-        if exc.name and exc.name.split(".")[0] in {"pegame", module.split(".")[0]}:
+@pytest.fixture
+def installed(monkeypatch):
+    """``installed(dist, group, name, target)``: the plugin's class, with the example
+    distribution (not installed) made importable and its config package searched;
+    skips when a dependency of the plugin is missing."""
+
+    def install(dist: Path, group: str, name: str, target: str) -> type:
+        if dist == DISTRIBUTIONS[-1]:
+            monkeypatch.syspath_prepend(str(dist))
+            (package,) = project_of(dist)["entry-points"]["pegame.configs"].values()
+            packages = {**defaults.config_packages(), "pegame-plugin-spinner": package}
+            monkeypatch.setattr(defaults, "config_packages", lambda: packages)
+            point = registry.EntryPoint(name, target, GROUPS[group])
+            known = registry._entry_points
+
+            def with_example(kind: str) -> dict[str, registry.EntryPoint]:
+                return {**known(kind), name: point} if kind == group else known(kind)
+
+            monkeypatch.setattr(registry, "_entry_points", with_example)
+        try:
+            return registry.load(group, name)
+        except registry.PluginError as exc:
+            missing = getattr(exc.__cause__, "name", None)
+            if missing and missing.split(".")[0] not in {"pegame", target.split(".")[0]}:
+                pytest.skip(f"{target} needs {missing}")
             raise
-        pytest.skip(f"{target} needs {exc.name}")
 
-
-# ------------------------------------------------------------------ reading comments
-
-
-def field_comments(config: type) -> dict[str, str]:
-    """The comment after each field of the dataclass ``config`` (and of its bases), by name:
-    ``radius: float = 0.2  # body radius (m)`` gives ``{"radius": "body radius (m)"}``."""
-    comments: dict[str, str] = {}
-    for cls in reversed(config.__mro__):
-        if not dataclasses.is_dataclass(cls) or not cls.__dict__.get("__annotations__"):
-            continue
-        tokens = tokenize.generate_tokens(
-            io.StringIO(textwrap.dedent(inspect.getsource(cls))).readline
-        )
-        depth, line, name = 0, [], None
-        for token in tokens:
-            if token.type == tokenize.INDENT:
-                depth += 1
-            elif token.type == tokenize.DEDENT:
-                depth -= 1
-            elif token.type == tokenize.NEWLINE:
-                line, name = [], None
-            elif token.type == tokenize.COMMENT and name is not None:
-                comments[name] = token.string.lstrip("#").strip()
-            elif depth == 1 and token.type not in (tokenize.NL, tokenize.COMMENT):
-                line.append(token)
-                if len(line) == 2 and line[0].type == tokenize.NAME and line[1].string == ":":
-                    name = line[0].string
-    return comments
-
-
-def yaml_comments(text: str) -> dict[str, str]:
-    """The comment after each top-level key of a YAML file, by key (a '#' inside quotes or
-    not preceded by a space is part of the value)."""
-    comments = {}
-    for line in text.splitlines():
-        match = re.match(r"(\w+):(.*)$", line)
-        if not match:
-            continue
-        rest, quote = match.group(2), None
-        for k, char in enumerate(rest):
-            if char in "\"'" and quote in (None, char):
-                quote = None if quote else char
-            elif char == "#" and quote is None and rest[k - 1 : k].isspace():
-                comments[match.group(1)] = rest[k + 1 :].strip()
-                break
-    return comments
-
-
-# --------------------------------------------------------------------------- the rules
-
-
-def defaults_of(config: type, skip: set[str] = frozenset()) -> dict[str, Any]:
-    made = config()
-    return {f.name: getattr(made, f.name) for f in dataclasses.fields(made) if f.name not in skip}
-
-
-def same_values(written: dict[str, Any], defaults: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
-    """Keys whose written value differs from the default in value or type: (written, default)."""
-    keys = set(written) | set(defaults)
-    return {
-        key: (written.get(key, "<missing>"), defaults.get(key, "<no such field>"))
-        for key in sorted(keys)
-        if key not in written
-        or key not in defaults
-        or written[key] != defaults[key]
-        or type(written[key]) is not type(defaults[key])
-    }
-
-
-def body_fields(group: str) -> set[str]:
-    """The fields every plugin of ``group`` inherits from its interface's Config (the
-    pursuer's and evader's bodies), written once in conf/config.yaml."""
-    return {f.name for f in dataclasses.fields(INTERFACES[group].Config)}
+    return install
 
 
 def test_every_registered_plugin_has_one_config_file_and_every_file_a_plugin():
@@ -171,22 +111,98 @@ def test_every_registered_plugin_has_one_config_file_and_every_file_a_plugin():
 
 
 @pytest.mark.parametrize("option", OPTIONS, ids=option_id)
-def test_the_config_file_repeats_the_dataclass(option, monkeypatch):
-    dist, group, name, target = option
-    cls = import_plugin(dist, target, monkeypatch)
-    path = config_root(dist) / group / f"{name}.yaml"
-    text = path.read_text()
-    written = yaml.safe_load(text)
-    assert written.pop("name") == name == path.stem
-    assert same_values(written, defaults_of(cls.Config, body_fields(group))) == {}
-    comments = yaml_comments(text)
-    comments.pop("name", None)
-    assert comments == {k: c for k, c in field_comments(cls.Config).items() if k in written}
+def test_the_config_file_holds_only_what_differs(option, installed):
+    cls = installed(*option)
+    check_config_file(option[1], cls, option[2])
 
 
-def config_yaml() -> tuple[str, dict[str, Any]]:
-    text = (ROOT / "pegame" / "conf" / "config.yaml").read_text()
-    return text, yaml.safe_load(text)
+@pytest.mark.parametrize("option", OPTIONS, ids=option_id)
+def test_the_composed_node_holds_every_default_of_the_config(option, installed):
+    dist, group, name, _ = option
+    cls = installed(*option)
+    node = OmegaConf.to_container(compose([f"{group}={name}"])[group])
+    made = cls.Config()
+    assert node == {
+        "name": name,
+        **{f.name: getattr(made, f.name) for f in dataclasses.fields(made)},
+    }
+
+
+class Shifted(SmartPursuer):
+    """The smart pursuer with other defaults, one of them also written in its file."""
+
+    @dataclasses.dataclass
+    class Config(SmartPursuer.Config):
+        standoff: float = 2.0  # m
+        radius: float = 0.3  # m
+
+
+def shifted_smart(monkeypatch) -> None:
+    real = registry.load
+    monkeypatch.setattr(
+        registry,
+        "load",
+        lambda kind, name: Shifted if (kind, name) == ("pursuer", "smart") else real(kind, name),
+    )
+
+
+def test_a_default_changed_in_the_config_is_the_composed_default(monkeypatch):
+    shifted_smart(monkeypatch)
+    node = compose(["pursuer=smart"]).pursuer
+    assert (node.standoff, node.radius, node.k_w) == (2.0, 0.3, 4.0)
+    assert compose(["pursuer=smart", "pursuer.standoff=1.0"]).pursuer.standoff == 1.0
+
+
+def package_with(tmp_path: Path, monkeypatch, group: str, name: str, text: str) -> str:
+    """The name of a config package (one per test) holding only ``group/name.yaml`` with
+    ``text``, the only one searched."""
+    name_of_package = f"conf_{tmp_path.name}"
+    package = tmp_path / name_of_package
+    (package / group).mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / group / f"{name}.yaml").write_text(text)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(defaults, "config_packages", lambda: {"fake": name_of_package})
+    return name_of_package
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            "name: smart\nstandoff: 1.5\nk_w: 3.0\n",
+            r"repeats SmartPursuer.Config's defaults of \['standoff'\]",
+        ),
+        ("name: smart\nstandof: 1.0\n", r"sets \['standof'\], which are no fields"),
+        ("name: smrt\n", "must say 'name: smart'"),
+    ],
+)
+def test_the_kit_refuses_a_file_repeating_a_default_or_setting_no_field(
+    tmp_path, monkeypatch, text, message
+):
+    package_with(tmp_path, monkeypatch, "pursuer", "smart", text)
+    with pytest.raises(ConformanceError, match=message):
+        check_config_file("pursuer", SmartPursuer, "smart")
+
+
+def test_a_file_value_overrides_the_config_default(tmp_path, monkeypatch):
+    package = package_with(
+        tmp_path, monkeypatch, "pursuer", "smart", "name: smart\nstandoff: 1.0\n"
+    )
+    check_config_file("pursuer", SmartPursuer, "smart")
+    node = OmegaConf.to_container(
+        defaults.PluginOptionSource("fake", f"pegame://{package}")
+        .load_config("pursuer/smart")
+        .config
+    )
+    assert node["standoff"] == 1.0 and node["k_w"] == 4.0 and node["name"] == "smart"
+
+
+def test_an_unknown_plugin_key_is_refused_with_the_closest():
+    with pytest.raises(
+        ConfigError, match="Unknown key 'pursuer.standof'. Did you mean 'pursuer.standoff'?"
+    ):
+        Game(compose(["+pursuer.standof=1.0"]))
 
 
 @pytest.mark.parametrize(
@@ -196,53 +212,12 @@ def config_yaml() -> tuple[str, dict[str, Any]]:
         ("evader", INTERFACES["evader"].Config),
         ("game", GameConfig),
         ("camera", Camera),
+        ("team", TeamConfig),
     ],
 )
-def test_config_yaml_repeats_the_bodies_game_and_camera(node, schema):
-    _, written = config_yaml()
-    assert same_values(written[node], defaults_of(schema)) == {}
-
-
-def node_comments(text: str, node: str) -> dict[str, str]:
-    """The comments of the keys under the top-level ``node:`` of a YAML text."""
-    block = re.search(rf"^{node}:.*\n((?:[ ]+.*\n)+)", text, flags=re.MULTILINE)
-    assert block, f"no node {node} in conf/config.yaml"
-    return yaml_comments(textwrap.dedent(block.group(1)))
-
-
-@pytest.mark.parametrize(
-    ("node", "schema"),
-    [
-        ("pursuer", INTERFACES["pursuer"].Config),
-        ("evader", INTERFACES["evader"].Config),
-        ("game", GameConfig),
-    ],
-)
-def test_config_yaml_comments_are_the_dataclass_comments(node, schema):
-    text, _ = config_yaml()
-    assert node_comments(text, node) == field_comments(schema)
-
-
-# ------------------------------------------------------------------- the readers
-
-
-@dataclasses.dataclass
-class _Commented:
-    """A dataclass as the test reads it: a docstring, fields with and without comments."""
-
-    plain: int = 1
-    noted: float = 2.0  # m, a note: with a colon
-    listed: list[str] = dataclasses.field(default_factory=lambda: ["#a"])  # '#rrggbb'
-
-    def __post_init__(self) -> None:
-        inner: int = 3  # not a field
-        del inner
-
-
-def test_field_comments_reads_field_lines_only():
-    assert field_comments(_Commented) == {"noted": "m, a note: with a colon", "listed": "'#rrggbb'"}
-
-
-def test_yaml_comments_skip_hashes_inside_values():
-    text = 'name: x\ncolours: ["#cc1f1a", "#1f38a6"]  # the shirt\nplain: 3\nnote: a#b   # m\n'
-    assert yaml_comments(text) == {"colours": "the shirt", "note": "m"}
+def test_config_yaml_holds_no_values_and_the_nodes_are_the_dataclass_defaults(node, schema):
+    text = (ROOT / "pegame" / "conf" / "config.yaml").read_text()
+    assert set(OmegaConf.create(text)) == {"defaults", "hydra"}
+    composed = compose([])[node]
+    made = schema()
+    assert {f.name: composed[f.name] for f in dataclasses.fields(made)} == dataclasses.asdict(made)

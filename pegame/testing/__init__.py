@@ -26,7 +26,7 @@ What is checked:
 2. *Config*: the defaults construct; an unknown key, a non-number for a numeric field and
    every value of ``bad_values`` raise :class:`pegame.errors.ConfigError` naming the key
    (``pursuer.turn_rate``); the config file Hydra finds (``conf/<kind>/<name>.yaml``) has
-   ``name: <name>`` and its values are the ``Config`` defaults.
+   ``name: <name>`` and holds only values that differ from the ``Config`` defaults.
 3. *Determinism*: two games with the plugin selected, built from the same seed, give equal
    results and trajectories (so the plugin draws only from the generator it is given, as
    DESIGN.md's one-generator-per-component rule asks), and neither touches numpy's global
@@ -192,25 +192,36 @@ def check_config_errors(
 
 
 def check_config_file(kind: str, cls: type[Plugin], name: str) -> None:
-    """Rule 2, the file: the option Hydra finds for ``kind=name`` has ``name: <name>`` and its
-    values are ``cls.Config``'s defaults (the file documents them)."""
-    from pegame.config import compose
+    """Rule 2, the file: the option Hydra finds for ``kind=name`` says ``name: <name>`` and
+    holds only what differs from ``cls.Config``'s defaults (which are the one place of
+    each default, :mod:`pegame.defaults`): fields of the Config, none repeating its
+    default."""
+    from omegaconf import OmegaConf
 
-    node = compose([f"{kind}={name}"])[kind]
+    from pegame.defaults import option_file
+
+    file = option_file(kind, name)
+    _fail_unless(file is not None, f"no config file {kind}/{name}.yaml on pegame's search path.")
+    assert file is not None
+    written = OmegaConf.to_container(OmegaConf.create(file.read_text()))
+    where = f"{kind}/{name}.yaml"
     _fail_unless(
-        node.name == name, f"conf/{kind}/{name}.yaml must say 'name: {name}', not {node.name!r}."
+        isinstance(written, dict) and written.get("name") == name,
+        f"{where} must say 'name: {name}', not {written!r}.",
     )
-    params = {k: v for k, v in node.items() if k != "name"}
-    config, defaults = registry.make_config(kind, cls, params), cls.Config()
-    differ = {
-        f.name: (getattr(config, f.name), getattr(defaults, f.name))
-        for f in dataclasses.fields(config)
-        if getattr(config, f.name) != getattr(defaults, f.name)
-    }
+    assert isinstance(written, dict)
+    fields = [f.name for f in dataclasses.fields(cls.Config)]
+    unknown = sorted(set(written) - {"name", "defaults", *fields})
     _fail_unless(
-        not differ,
-        f"conf/{kind}/{name}.yaml must hold {cls.__name__}.Config's defaults; "
-        f"(file, default) differ for {differ}.",
+        not unknown, f"{where} sets {unknown}, which are no fields of {cls.__name__}.Config."
+    )
+    params = {k: v for k, v in written.items() if k in fields}
+    config, defaults = registry.make_config(kind, cls, params), cls.Config()
+    repeated = sorted(k for k in params if getattr(config, k) == getattr(defaults, k))
+    _fail_unless(
+        not repeated,
+        f"{where} repeats {cls.__name__}.Config's defaults of {repeated}: a default is "
+        f"written once, in the Config; the file holds only the values that differ.",
     )
 
 
@@ -336,7 +347,7 @@ class PluginConformance:
     def test_config_errors_name_the_key(self) -> None:
         check_config_errors(self.kind, self.plugin_class(), self.bad_values)
 
-    def test_config_file_holds_the_defaults(self) -> None:
+    def test_config_file_holds_only_what_differs(self) -> None:
         check_config_file(self.kind, self.plugin_class(), self.plugin)
 
     def test_same_seed_same_game(self) -> None:
