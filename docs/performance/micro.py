@@ -26,7 +26,7 @@ from pegame.envs.crop import LocalCrop, _crop
 from pegame.game import Game
 from pegame.grid.cells import cell_centres
 from pegame.navigation.planner import Planner
-from pegame.trig import exps
+from pegame.numerics import exps
 from pegame.types import Pose
 
 
@@ -89,7 +89,7 @@ def main() -> None:
         ("crop 32 x 32", lambda: crop(5.0, 6.0, 0.3, out), crop_by_division),
         ("Planner.shared", lambda: Planner.shared(grid, 0.2), bound_signature),
         (
-            "exp of 2000 (pegame.trig.exps / numpy)",
+            "exp of 2000 (pegame.numerics.exps / numpy)",
             lambda: exps(exponents),
             lambda: np.exp(exponents),
         ),

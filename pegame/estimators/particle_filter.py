@@ -49,7 +49,7 @@ time, and both paths use the same draws. The plain numpy reference
 :meth:`ParticleFilter.update_reference` gives the same particles, weights, N_eff and
 moments to round-off (the tests hold it to 1e-12 relative): the kernels sum in order
 where numpy sums pairwise, and take the headings' sines and cosines from a vectorised
-polynomial (:mod:`pegame.trig`, within 2^-52 of libm's), about four times faster.
+polynomial (:mod:`pegame.numerics`, within 2^-52 of libm's), about four times faster.
 """
 
 from __future__ import annotations
@@ -67,7 +67,7 @@ from pegame.api import Estimator
 from pegame.errors import MapError, require
 from pegame.estimators.resampling import RESAMPLERS, ThresholdResampler, effective_sample_size
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
-from pegame.trig import (
+from pegame.numerics import (
     MAX_ANGLE,
     exps,
     sin_cos,
@@ -111,7 +111,7 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
 
     Particle i moves at speed v_max * unit_speeds[i] (m/s) and turn rate turn_rate_std *
     normals[i] (rad/s), as :meth:`ParticleFilter._predict` does with the same draws; the
-    headings' sines and cosines come from :func:`pegame.trig.sin_cos` (within 2^-52 of
+    headings' sines and cosines come from :func:`pegame.numerics.sin_cos` (within 2^-52 of
     numpy's) and the cells from ``OccupancyGrid.world_to_cell`` operation for operation.
 
     frame: the grid's :class:`pegame.grid.GridFrame`.
@@ -153,7 +153,7 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
 def _likelihoods(moved, zx, zy, two_sigma2):
     """exp(-|p_i - z|^2 / (2 sigma^2)) per particle (N,): the Gaussian likelihood of a
     detection at (zx, zy) (map frame, m), 0 where it would be below the smallest normal
-    float (:func:`pegame.trig.exps`, the same bits on every CPU)."""
+    float (:func:`pegame.numerics.exps`, the same bits on every CPU)."""
     exponents = np.empty(moved.shape[0])
     for i in range(moved.shape[0]):
         dx, dy = moved[i, 0] - zx, moved[i, 1] - zy

@@ -7,8 +7,7 @@
   :mod:`pegame.vector.features` (observations) per game; :mod:`pegame.vector.state` the
   arrays and numbers they take;
 - :mod:`pegame.vector.opponents`: the scripted opponent of a learner;
-- :mod:`pegame.vector.metrics`: the measures kept as running sums;
-- :mod:`pegame.vector.exact`: Python's hypot and angle wrap, bit for bit, in numba.
+- :mod:`pegame.vector.metrics`: the measures kept as running sums.
 
 The Gymnasium vector envs on it are in :mod:`pegame.envs.vector`.
 """

@@ -12,7 +12,7 @@ the ground truth in_view, the same tests and float operations as the plain code.
   observation's memory of the last detection.
 
 Python's ``math.hypot`` and :func:`pegame.types.wrap_angle` come from
-:mod:`pegame.vector.exact`. ``tests/test_vector_kernels.py`` compares them with the plain
+:mod:`pegame.numerics`. ``tests/vector/test_kernels.py`` compares them with the plain
 functions.
 """
 
@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-from pegame.vector.exact import (
+from pegame.numerics import (
     cell_by_division,
     cell_by_product,
     hypot,
@@ -62,7 +62,7 @@ _CHUNK = 32
 @njit(cache=True, inline="always")
 def _sample_cells(frame, height, width, ax, ay, dx, dy, count, start, size, cells, rotated):
     """The cells (1 + flat index, 0 off the grid) of samples start..start + size - 1 of
-    the segment into ``cells`` by :func:`pegame.vector.exact.cell_by_product`; returns
+    the segment into ``cells`` by :func:`pegame.numerics.cell_by_product`; returns
     whether all are decided. Inlined with ``rotated`` a constant (no branch in the loop).
     """
     inverse = 1.0 / frame[5]
@@ -91,7 +91,7 @@ def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
     """:func:`pegame.visibility.sight._segment_clear` on the grid: True when no sample of
     the segment from (ax, ay) to (bx, by) (m), ``step`` m apart, lies in a blocked or
     off-grid cell. The same samples and cells (the tests compare the two), found
-    _CHUNK at a time from products (:func:`pegame.vector.exact.cell_by_product`; a chunk
+    _CHUNK at a time from products (:func:`pegame.numerics.cell_by_product`; a chunk
     with a sample near a cell edge is found again by the division), then looked up in
     ``values`` = world.sight_values (entry 0: off the grid, blocked); the test stops at
     the first chunk with a blocked cell. ``frame``, ``blocked``: world.frame and

@@ -14,7 +14,7 @@ from numba import njit, prange
 
 from pegame.envs.crop import lattice_crop
 from pegame.envs.observations import AGE_SCALE
-from pegame.vector.exact import cell_by_division, hypot, wrap_angle
+from pegame.numerics import cell_by_division, hypot, wrap_angle
 from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER
 
 

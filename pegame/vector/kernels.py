@@ -22,9 +22,9 @@ import math
 
 from numba import njit, prange
 
+from pegame.numerics import ceil_of_hypot, hypot, wrap_angle
 from pegame.sims.grid import _sweep
 from pegame.vector.camera import sense
-from pegame.vector.exact import ceil_of_hypot, hypot, wrap_angle
 from pegame.vector.state import (
     A_MAX,
     ALPHA_MAX,

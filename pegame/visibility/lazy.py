@@ -22,7 +22,7 @@ from numba import njit
 
 from pegame.grid import OccupancyGrid
 from pegame.grid.occupancy import OX, OY, RESOLUTION
-from pegame.trig import wrap_angle_kernel
+from pegame.numerics import wrap_angle_kernel
 from pegame.types import Camera, Pose
 from pegame.visibility.rays import directions, ray_tables
 from pegame.visibility.region import MaskRegion, lookup, march, whole_region

@@ -15,7 +15,7 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
-from pegame.trig import MAX_ANGLE, sin_cos
+from pegame.numerics import MAX_ANGLE, sin_cos
 from pegame.types import Camera, Pose
 
 
@@ -51,7 +51,7 @@ def ray_directions(pose: Pose, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
 @njit(cache=True)
 def directions(theta, angles, first, stop):
     """Unit directions (cos, sin) (each (stop - first,)) of the rays at angles[first:stop]
-    (rad) from the heading theta (rad), by the vectorised :func:`pegame.trig.sin_cos`.
+    (rad) from the heading theta (rad), by the vectorised :func:`pegame.numerics.sin_cos`.
     Every path takes its directions from here, so they all sample the same points."""
     count = stop - first
     cos_a, sin_a = np.empty(count), np.empty(count)

@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import fields
 from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 from pegame import registry
 from pegame.api import Context
@@ -81,18 +79,6 @@ def on_free(grid, particles):
 
 
 # --------------------------------------------------------------------------- configs
-
-
-@pytest.mark.parametrize(
-    ("cls", "stem"), [(ParticleFilter, "particle_filter"), (KalmanEstimator, "kalman")]
-)
-def test_config_file_matches_config_class(cls, stem):
-    doc = yaml.safe_load((CONF / f"{stem}.yaml").read_text())
-    assert doc.pop("name") == stem
-    assert registry.load("estimator", stem) is cls
-    defaults = {f.name: f.default for f in fields(cls.Config)}
-    assert doc == defaults
-    assert registry.make_config("estimator", cls, doc) == cls.Config()
 
 
 @pytest.mark.parametrize(
@@ -311,7 +297,7 @@ def test_update_kernels_match_the_reference_when_the_weights_vanish():
 
 
 def test_motion_kernel_matches_the_reference_beyond_the_polynomial_range():
-    # Headings past pegame.trig's range take libm's sine and cosine in the kernel.
+    # Headings past pegame.numerics's range take libm's sine and cosine in the kernel.
     grid = room()
     fast = build(ParticleFilter, grid, seed=5, n_particles=400)
     slow = build(ParticleFilter, grid, seed=5, n_particles=400)

@@ -5,14 +5,11 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import fields
-from importlib.resources import files
 
 import numpy as np
 import pytest
-from omegaconf import OmegaConf
 
-from pegame.api import Context, Pursuer, PursuerObservation
+from pegame.api import Context, PursuerObservation
 from pegame.errors import ConfigError
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid
 from pegame.navigation import inflate
@@ -272,17 +269,6 @@ def test_unreachable_estimate_scans_toward_it(caplog):
 def test_bad_config_names_the_key(params, key):
     with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
         make_config("pursuer", SmartPursuer, params)
-
-
-def test_config_file_matches_the_defaults():
-    node = OmegaConf.to_container(
-        OmegaConf.load(str(files("pegame.conf") / "pursuer" / "smart.yaml"))
-    )
-    assert node.pop("name") == "smart"
-    defaults = SmartPursuer.Config()
-    own = {f.name for f in fields(defaults)} - {f.name for f in fields(Pursuer.Config)}
-    assert set(node) == own
-    assert all(node[key] == getattr(defaults, key) for key in own)
 
 
 def test_a_blocked_approach_detours_around_the_wall_end_unless_the_detour_is_off():

@@ -7,17 +7,14 @@ reader of rerun-sdk (``rerun.chunk.RrdReader``), counting each entity's rows on 
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import subprocess
 import sys
 from collections import defaultdict
-from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 from pegame.api import Context, Tick
 from pegame.figures import plot_trajectory
@@ -459,13 +456,6 @@ def test_recording_id_is_deterministic_per_place_and_config(tmp_path):
     assert recording_id(tmp_path, "game", config) != recording_id(
         tmp_path, "game", {"game": {"seed": 4}}
     )
-
-
-def test_config_file_lists_every_field_with_its_default():
-    conf = Path(str(files("pegame.conf"))) / "recorder" / "rerun.yaml"
-    values = yaml.safe_load(conf.read_text())
-    defaults = {f.name: f.default for f in dataclasses.fields(RerunRecorder.Config)}
-    assert values == {"name": "rerun", **defaults}
 
 
 def test_importing_the_null_recorder_and_replay_does_not_import_rerun():

@@ -1,5 +1,6 @@
 """The batched game's kernels (pegame.vector) against the plain code they reproduce, bit for
-bit: Python's hypot and angle wrap, the crop, the in-view tests and the simulator's move."""
+bit: the crop, the in-view tests and the simulator's move (Python's hypot and angle wrap in
+numba: tests/test_numerics.py)."""
 
 from __future__ import annotations
 
@@ -12,9 +13,9 @@ from pegame.envs.crop import local_crop_reference
 from pegame.envs.vector import vector_env
 from pegame.grid import OccupancyGrid
 from pegame.sims.grid import _Agent
-from pegame.types import Pose, Velocity, wrap_angle
+from pegame.types import Pose, Velocity
 from pegame.vector import camera as batched_camera
-from pegame.vector import exact, kernels
+from pegame.vector import kernels
 from pegame.vector.features import crop_into
 from pegame.vector.game import _world
 from pegame.vector.state import new_state
@@ -27,27 +28,6 @@ def game():
     env = vector_env(1, overrides=["env=hall", "evader.model=action"], opponent="random")
     env.reset(seed=0)
     return env.game
-
-
-def test_hypot_is_pythons_bit_for_bit():
-    rng = np.random.default_rng(0)
-    pairs = rng.uniform(-20.0, 20.0, (20000, 2))
-    pairs[:200] *= 1e-300
-    pairs[200:400] *= 1e300
-    specials = [(0.0, 0.0), (-0.0, 3.0), (math.inf, 1.0), (1.0, -math.inf), (3.0, 4.0)]
-    for x, y in [*pairs.tolist(), *specials]:
-        assert exact.hypot(x, y) == math.hypot(x, y), (x, y)
-    assert math.isnan(exact.hypot(math.nan, 1.0))
-
-
-def test_wrap_angle_is_pegames_bit_for_bit():
-    rng = np.random.default_rng(1)
-    angles = rng.uniform(-12.0, 12.0, 20000).tolist()
-    pi = math.pi
-    edges = [pi, -pi, 3 * pi, -3 * pi, 2 * pi, 0.0, -0.0, 1e4, -1e4]
-    edges += [math.nextafter(a, b) for a in (pi, -pi, 3 * pi, -3 * pi) for b in (0.0, 10.0)]
-    for angle in angles + edges:
-        assert exact.wrap_angle(angle) == wrap_angle(angle), angle
 
 
 def test_crop_is_the_reference_crop(game):
@@ -199,17 +179,3 @@ def test_move_is_the_grid_simulators(game, a_max):
         assert tuple(state.poses[0, 0]) == (agent.pose.x, agent.pose.y, agent.pose.theta)
         if agent.limited:
             assert tuple(state.velocities[0, 0]) == (agent.velocity.v, agent.velocity.w)
-
-
-def test_hypot_shortcuts_answer_as_the_exact_hypot():
-    rng = np.random.default_rng(5)
-    res = 0.05
-    pairs = rng.uniform(-0.1, 0.1, (20000, 2)).tolist()
-    # Lengths on the edges: whole numbers of half cells, and the camera's range limits.
-    for length in (0.025, 0.05, 0.075, 0.3, 5.0):
-        angles = rng.uniform(-math.pi, math.pi, 2000)
-        pairs += np.column_stack([length * np.cos(angles), length * np.sin(angles)]).tolist()
-    for x, y in pairs:
-        assert exact.ceil_of_hypot(x, y, res) == math.ceil(2 * math.hypot(x, y) / res)
-        assert exact.hypot_within(x, y, 0.3, 5.0) == (0.3 <= math.hypot(x, y) <= 5.0)
-        assert exact.hypot_within(x, y, 0.025, 0.075) == (0.025 <= math.hypot(x, y) <= 0.075)

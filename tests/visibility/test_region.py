@@ -188,7 +188,7 @@ def test_region_over_a_block_equals_the_whole_mask_there(seed):
 )
 def test_region_over_a_block_is_exact_where_bearings_wrap_at_pi(theta):
     # The rays reaching a block are found from bearings wrapped to (-pi, pi] (the one angle
-    # wrap of pegame.trig); a camera looking along -x at blocks around that bearing puts
+    # wrap of pegame.numerics); a camera looking along -x at blocks around that bearing puts
     # the bearings on both sides of the seam.
     grid = empty_grid(60, 60, 0.1)
     pose = Pose(5.0, 3.0, theta)

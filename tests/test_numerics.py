@@ -1,4 +1,5 @@
-"""The vectorisable sin_cos against libm (through numpy), and the one angle wrap."""
+"""pegame.numerics against what it reproduces: sin_cos against libm (through numpy), exps,
+Python's hypot and angle wrap in numba bit for bit, and the particle filter's wrap."""
 
 from __future__ import annotations
 
@@ -8,7 +9,8 @@ import numpy as np
 import pytest
 from numba import njit
 
-from pegame.trig import (
+from pegame import numerics
+from pegame.numerics import (
     MAX_ANGLE,
     sin_cos,
     wrap_angle_kernel,
@@ -89,7 +91,7 @@ def test_wraps_land_in_minus_pi_to_pi_and_agree_with_the_scalar_wrap_within_ulps
 
 
 def test_exps_is_within_one_ulp_of_libm_and_zero_below_the_normal_range():
-    from pegame.trig import EXP_MAX, EXP_NORMAL_MIN, exps
+    from pegame.numerics import EXP_MAX, EXP_NORMAL_MIN, exps
 
     rng = np.random.default_rng(41)
     xs = np.concatenate(
@@ -114,3 +116,38 @@ def test_exps_is_within_one_ulp_of_libm_and_zero_below_the_normal_range():
         exact = math.exp(x)
         assert abs(ours - exact) <= math.ulp(exact), x
     assert np.all(exps(np.array([EXP_NORMAL_MIN - 1e-9, -745.0, -1e308, -math.inf])) == 0.0)
+
+
+def test_hypot_is_pythons_bit_for_bit():
+    rng = np.random.default_rng(0)
+    pairs = rng.uniform(-20.0, 20.0, (20000, 2))
+    pairs[:200] *= 1e-300
+    pairs[200:400] *= 1e300
+    specials = [(0.0, 0.0), (-0.0, 3.0), (math.inf, 1.0), (1.0, -math.inf), (3.0, 4.0)]
+    for x, y in [*pairs.tolist(), *specials]:
+        assert numerics.hypot(x, y) == math.hypot(x, y), (x, y)
+    assert math.isnan(numerics.hypot(math.nan, 1.0))
+
+
+def test_wrap_angle_is_pegames_bit_for_bit():
+    rng = np.random.default_rng(1)
+    angles = rng.uniform(-12.0, 12.0, 20000).tolist()
+    pi = math.pi
+    edges = [pi, -pi, 3 * pi, -3 * pi, 2 * pi, 0.0, -0.0, 1e4, -1e4]
+    edges += [math.nextafter(a, b) for a in (pi, -pi, 3 * pi, -3 * pi) for b in (0.0, 10.0)]
+    for angle in angles + edges:
+        assert numerics.wrap_angle(angle) == wrap_angle(angle), angle
+
+
+def test_hypot_shortcuts_answer_as_the_exact_hypot():
+    rng = np.random.default_rng(5)
+    res = 0.05
+    pairs = rng.uniform(-0.1, 0.1, (20000, 2)).tolist()
+    # Lengths on the edges: whole numbers of half cells, and the camera's range limits.
+    for length in (0.025, 0.05, 0.075, 0.3, 5.0):
+        angles = rng.uniform(-math.pi, math.pi, 2000)
+        pairs += np.column_stack([length * np.cos(angles), length * np.sin(angles)]).tolist()
+    for x, y in pairs:
+        assert numerics.ceil_of_hypot(x, y, res) == math.ceil(2 * math.hypot(x, y) / res)
+        assert numerics.hypot_within(x, y, 0.3, 5.0) == (0.3 <= math.hypot(x, y) <= 5.0)
+        assert numerics.hypot_within(x, y, 0.025, 0.075) == (0.025 <= math.hypot(x, y) <= 0.075)
