@@ -30,6 +30,7 @@ from numba import njit
 from scipy.ndimage import maximum_filter
 
 from pegame.grid import OccupancyGrid
+from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 
 
 @lru_cache(maxsize=16)
@@ -145,7 +146,7 @@ def lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, colum
     in a second, a gather that does not vectorise (an unsigned index: no test for
     negative ones).
     """
-    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
+    gx, gy, gc, gs, res = frame[OX], frame[OY], frame[COS_YAW], frame[SIN_YAW], frame[RESOLUTION]
     padded_height, padded_width = table.shape
     pad = (padded_width - width) // 2
     inverse = 1.0 / res
@@ -202,8 +203,8 @@ def _crop_fast(table, centres, frame, width, pooled, off_x, off_y, x, y, c, s, o
     when it decides every cell, else by :func:`_crop`'s division."""
     if lattice_crop(table, centres, frame, width, x, y, c, s, out, 0, cells, columns):
         return
-    rotate = frame[4] != 0.0
-    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
+    rotate = frame[ROTATED] != 0.0
+    gx, gy, gc, gs, res = frame[OX], frame[OY], frame[COS_YAW], frame[SIN_YAW], frame[RESOLUTION]
     _crop(pooled, off_x, off_y, x, y, c, s, gx, gy, gc, gs, rotate, res, out)
 
 

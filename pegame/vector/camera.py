@@ -23,6 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
+from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.numerics import (
     cell_by_division,
     cell_by_product,
@@ -65,7 +66,7 @@ def _sample_cells(frame, height, width, ax, ay, dx, dy, count, start, size, cell
     the segment into ``cells`` by :func:`pegame.numerics.cell_by_product`; returns
     whether all are decided. Inlined with ``rotated`` a constant (no branch in the loop).
     """
-    inverse = 1.0 / frame[5]
+    inverse = 1.0 / frame[RESOLUTION]
     decided = True
     for j in range(size):
         u, v = _sample_point(frame, ax, ay, dx, dy, start + j, count, rotated)
@@ -79,10 +80,10 @@ def _sample_point(frame, ax, ay, dx, dy, k, count, rotated):
     """Grid-frame point (u, v) (m) of sample k of count along the segment from (ax, ay)
     by (dx, dy), as :func:`pegame.visibility.sight._segment_clear` places it."""
     t = 1.0 if k == count else k * (1.0 / count)
-    u = ax + t * dx - frame[0]
-    v = ay + t * dy - frame[1]
+    u = ax + t * dx - frame[OX]
+    v = ay + t * dy - frame[OY]
     if rotated:
-        u, v = frame[2] * u + frame[3] * v, -frame[3] * u + frame[2] * v
+        u, v = frame[COS_YAW] * u + frame[SIN_YAW] * v, -frame[SIN_YAW] * u + frame[COS_YAW] * v
     return u, v
 
 
@@ -98,7 +99,7 @@ def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
     world.blocked. (The functions here take the world's arrays, not the World: an
     inlined function given a NamedTuple pays a reference count per array.)"""
     height, width = blocked.shape
-    rotated = frame[4] != 0.0
+    rotated = frame[ROTATED] != 0.0
     count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
     dx, dy = bx - ax, by - ay
     cells = np.empty(_CHUNK, np.int64)
@@ -115,7 +116,7 @@ def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
         if not decided:
             for j in range(size):
                 u, v = _sample_point(frame, ax, ay, dx, dy, start + j, count, rotated)
-                cells[j] = cell_by_division(u, v, frame[5], height, width)
+                cells[j] = cell_by_division(u, v, frame[RESOLUTION], height, width)
         for j in range(size):
             if values[cells[j]]:
                 return False
@@ -131,7 +132,7 @@ def point_in_view(frame, blocked, values, camera, px, py, ptheta, x, y):
         return False
     if abs(wrap_angle(math.atan2(dy, dx) - ptheta)) > 0.5 * camera[FOV]:
         return False
-    return segment_clear(frame, blocked, values, px, py, x, y, 0.5 * frame[5])
+    return segment_clear(frame, blocked, values, px, py, x, y, 0.5 * frame[RESOLUTION])
 
 
 @njit(cache=True, inline="always")

@@ -14,6 +14,7 @@ from numba import njit, prange
 
 from pegame.envs.crop import lattice_crop
 from pegame.envs.observations import AGE_SCALE
+from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.numerics import cell_by_division, hypot, wrap_angle
 from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER
 
@@ -42,11 +43,11 @@ def _divided_crop(world, x, y, c, s, out, at):
     table, off_x, off_y, frame = world.crop_table, world.crop_x, world.crop_y, world.crop_frame
     height, width = world.pooled.shape
     pad = (table.shape[1] - width) // 2
-    gx, gy, gc, gs, res = frame[0], frame[1], frame[2], frame[3], frame[5]
+    gx, gy, gc, gs, res = frame[OX], frame[OY], frame[COS_YAW], frame[SIN_YAW], frame[RESOLUTION]
     for k in range(off_x.size):
         dx = x + (c * off_x[k] - s * off_y[k]) - gx
         dy = y + (s * off_x[k] + c * off_y[k]) - gy
-        if frame[4] != 0.0:
+        if frame[ROTATED] != 0.0:
             dx, dy = gc * dx + gs * dy, -gs * dx + gc * dy
         cell = cell_by_division(dx, dy, res, height, width)
         if cell == 0:

@@ -22,6 +22,7 @@ import math
 
 from numba import njit, prange
 
+from pegame.grid.occupancy import RESOLUTION
 from pegame.numerics import ceil_of_hypot, hypot, wrap_angle
 from pegame.sims.grid import _sweep
 from pegame.vector.camera import sense
@@ -91,7 +92,7 @@ def move(masks, frame, bodies, poses, velocities, commands, game, role, dt):
         dx = radius * (math.sin(theta) - math.sin(theta0))
         dy = -radius * (math.cos(theta) - math.cos(theta0))
     tx, ty = x0 + dx, y0 + dy
-    n = max(1, ceil_of_hypot(tx - x0, ty - y0, frame[5]))
+    n = max(1, ceil_of_hypot(tx - x0, ty - y0, frame[RESOLUTION]))
     x, y = _sweep(masks[role], x0, y0, tx, ty, n, frame)
     poses[game, role, 0], poses[game, role, 1], poses[game, role, 2] = x, y, wrap_angle(theta)
     if limited:
