@@ -90,15 +90,15 @@ class _Players:
             grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), self.camera, 0.1, 1.0
         )
         self.rng = np.random.default_rng(0)
-        made = []
-        for seed, (kind, name) in enumerate(
-            (("evader", "smart"), ("estimator", "particle_filter"), ("pursuer", "smart"))
-        ):
-            cls = registry.load(kind, name)
-            made.append(
-                cls(registry.make_config(kind, cls, {}), self.context, np.random.default_rng(seed))
-            )
-        self.evader, self.estimator, self.pursuer = made
+        evader = registry.load("evader", "smart")
+        estimator = registry.load("estimator", "particle_filter")
+        pursuer = registry.load("pursuer", "smart")
+        rngs = [np.random.default_rng(seed) for seed in range(3)]
+        self.evader = evader(registry.make_config("evader", evader, {}), self.context, rngs[0])
+        self.estimator = estimator(
+            registry.make_config("estimator", estimator, {}), self.context, rngs[1]
+        )
+        self.pursuer = pursuer(registry.make_config("pursuer", pursuer, {}), self.context, rngs[2])
 
     def start(self):
         """A game-like start (pursuer pose, evader pose, the pursuer's region)."""

@@ -141,7 +141,8 @@ def agents(header: Sequence[str]) -> list[tuple[str, str, str]]:
             members += 1
         for k in range(members):
             fade = 0.6 * k / max(members, 1)  # towards white, never all the way
-            color = to_hex([c + (1 - c) * fade for c in to_rgb(base)])
+            red, green, blue = (c + (1 - c) * fade for c in to_rgb(base))
+            color = to_hex((red, green, blue))
             found.append((f"{role} {k}", f"{role}_{k}", color))
     return found
 

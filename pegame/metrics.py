@@ -40,7 +40,7 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
 
 
-def _rounded(value: float | None) -> float | None:
+def _rounded(value: float | np.floating | None) -> float | None:
     """Round for the result file (values are deterministic; rounding only shortens them)."""
     return None if value is None or not math.isfinite(value) else round(float(value), 6)
 
@@ -187,7 +187,7 @@ class TeamMetrics:
         summaries = [m.summary() for m in self.per_evader]
         result: dict[str, float | int | list | None] = {}
         for key in summaries[0]:
-            values = [s[key] for s in summaries if s[key] is not None]
+            values = [v for v in (s[key] for s in summaries) if v is not None]
             result[key] = _rounded(np.mean(values)) if values else None
         ticks = max(1, self.ticks)
         result["tracking_rate"] = _rounded(self.tracking_rate)

@@ -15,9 +15,19 @@ import warnings
 from collections.abc import Iterable, Mapping
 from functools import cache
 from importlib.metadata import EntryPoint, entry_points
-from typing import Any
+from typing import Any, Literal, overload
 
-from pegame.api import INTERFACES, PLUGIN_KINDS, Plugin
+from pegame.api import (
+    INTERFACES,
+    PLUGIN_KINDS,
+    Detector,
+    Estimator,
+    Evader,
+    Plugin,
+    Pursuer,
+    Recorder,
+    Simulator,
+)
 from pegame.errors import ConfigError, PegameError
 
 #: config group -> entry-point group, derived from :data:`pegame.api.PLUGIN_KINDS`
@@ -94,6 +104,20 @@ def distribution_of(point: EntryPoint) -> str:
     return dist.name if dist is not None else "?"
 
 
+@overload
+def load(group: Literal["sim"], name: str) -> type[Simulator]: ...
+@overload
+def load(group: Literal["detector"], name: str) -> type[Detector]: ...
+@overload
+def load(group: Literal["estimator"], name: str) -> type[Estimator]: ...
+@overload
+def load(group: Literal["pursuer"], name: str) -> type[Pursuer]: ...
+@overload
+def load(group: Literal["evader"], name: str) -> type[Evader]: ...
+@overload
+def load(group: Literal["recorder"], name: str) -> type[Recorder]: ...
+@overload
+def load(group: str, name: str) -> type[Plugin]: ...
 def load(group: str, name: str) -> type[Plugin]:
     """Import and return the plugin class ``name`` of ``group``, checking its interface."""
     point = entry_point(group, name)

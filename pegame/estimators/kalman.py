@@ -27,16 +27,16 @@ evader corrects the filter in turn (:meth:`KalmanEstimator.update_team`).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from filterpy.common import Q_discrete_white_noise
 from filterpy.kalman import KalmanFilter
 
-from pegame.api import Estimator
+from pegame.api import Context, Estimator
 from pegame.errors import require
-from pegame.types import EMPTY_BELIEF, Belief, Detection, Pose
-from pegame.visibility import VisibilityRegion
+from pegame.types import EMPTY_BELIEF, Belief, Detection, Pose, Region
 
 
 class KalmanEstimator(Estimator):
@@ -54,13 +54,11 @@ class KalmanEstimator(Estimator):
                 value = getattr(self, key)
                 require(0.0 < value < math.inf, key, "a finite std > 0", value)
 
-    def __init__(self, config: Config, context, rng: np.random.Generator) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         self._kf: KalmanFilter | None = None
 
-    def reset(
-        self, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
-    ) -> Belief:
+    def reset(self, pursuer: Pose, detection: Detection | None, visible: Region) -> Belief:
         """Forget the track; start one at ``detection`` if there is one."""
         self._kf = None
         if detection is not None:
@@ -68,7 +66,7 @@ class KalmanEstimator(Estimator):
         return self._belief()
 
     def update(
-        self, dt: float, pursuer: Pose, detection: Detection | None, visible: VisibilityRegion
+        self, dt: float, pursuer: Pose, detection: Detection | None, visible: Region
     ) -> Belief:
         """Predict ``dt`` s ahead, then correct with the detection's map position if any."""
         if self._kf is None:
@@ -81,39 +79,48 @@ class KalmanEstimator(Estimator):
             dim=2, dt=dt, var=self.config.accel_std**2, block_size=2, order_by_dim=False
         )
         kf.predict()
-        self._clamp_speed()
+        _clamp_speed(kf, self.context.evader.v_max)
         if detection is not None:
             kf.update(np.asarray(detection.position, dtype=float))
-            self._clamp_speed()
+            _clamp_speed(kf, self.context.evader.v_max)
         return self._belief()
 
-    def reset_team(self, pursuers, detections, region) -> Belief:
+    def reset_team(
+        self, pursuers: Sequence[Pose], detections: Sequence[Detection | None], region: Region
+    ) -> Belief:
         """Forget the track; start one at the first detection and correct it with the others."""
         self._kf = None
         seen = [d for d in detections if d is not None]
         if seen:
-            self._start(seen[0].position)
-            self._correct(seen[1:])
+            self._correct(self._start(seen[0].position), seen[1:])
         return self._belief()
 
-    def update_team(self, dt, pursuers, detections, region) -> Belief:
+    def update_team(
+        self,
+        dt: float,
+        pursuers: Sequence[Pose],
+        detections: Sequence[Detection | None],
+        region: Region,
+    ) -> Belief:
         """Predict ``dt`` s ahead, then correct with every pursuer's detection in turn
         (independent measurements of one position: sequential updates are the batch
         update)."""
         seen = [d for d in detections if d is not None]
-        if self._kf is None:
+        kf = self._kf
+        if kf is None:
             return self.reset_team(pursuers, detections, region)
-        self.update(dt, pursuers[0], seen[0] if seen else None, region)
-        self._correct(seen[1:])
+        self.update(dt, pursuers[0], seen[0] if seen else None, region)  # updates kf
+        self._correct(kf, seen[1:])
         return self._belief()
 
-    def _correct(self, detections) -> None:
-        """Kalman updates with each of ``detections``' map positions, speed clamped."""
+    def _correct(self, kf: KalmanFilter, detections: Sequence[Detection]) -> None:
+        """Kalman updates of ``kf`` with each of ``detections``' map positions, speed
+        clamped."""
         for detection in detections:
-            self._kf.update(np.asarray(detection.position, dtype=float))
-            self._clamp_speed()
+            kf.update(np.asarray(detection.position, dtype=float))
+            _clamp_speed(kf, self.context.evader.v_max)
 
-    def _start(self, position: tuple[float, float]) -> None:
+    def _start(self, position: tuple[float, float]) -> KalmanFilter:
         """A filter at ``position`` (m), at rest, with the velocity's std v_max (m/s)."""
         kf = KalmanFilter(dim_x=4, dim_z=2)
         kf.x = np.array([position[0], position[1], 0.0, 0.0])
@@ -122,14 +129,7 @@ class KalmanEstimator(Estimator):
         v_max = self.context.evader.v_max
         kf.P = np.diag([self.config.measurement_std**2] * 2 + [v_max**2] * 2)
         self._kf = kf
-
-    def _clamp_speed(self) -> None:
-        """Scale the velocity estimate down to the evader's max speed if it exceeds it."""
-        velocity = self._kf.x[2:4]
-        speed = float(np.hypot(*velocity))
-        v_max = self.context.evader.v_max
-        if speed > v_max:
-            self._kf.x[2:4] = velocity * (v_max / speed)
+        return kf
 
     def _belief(self) -> Belief:
         if self._kf is None:
@@ -143,3 +143,11 @@ def transition(dt: float) -> np.ndarray:
     f = np.eye(4)
     f[0, 2] = f[1, 3] = dt
     return f
+
+
+def _clamp_speed(kf: KalmanFilter, v_max: float) -> None:
+    """Scale ``kf``'s velocity estimate down to ``v_max`` (m/s) if it exceeds it."""
+    velocity = kf.x[2:4]
+    speed = float(np.hypot(*velocity))
+    if speed > v_max:
+        kf.x[2:4] = velocity * (v_max / speed)

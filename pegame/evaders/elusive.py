@@ -136,7 +136,8 @@ class ElusiveEvader(Evader):
         self.reset(Pose(0.0, 0.0))
 
     def reset(self, pose: Pose) -> None:
-        self.plan, self._goal_cell = Plan(), None
+        self.plan = Plan()
+        self._goal_cell: tuple[int, int] | None = None
         self.follower.set_path(np.zeros((0, 2)))
 
     def decide(self, observation: EvaderObservation) -> Plan:
@@ -150,7 +151,8 @@ class ElusiveEvader(Evader):
         goal_cell = divmod(cell, self.context.grid.width)
         goal, path = self.plan.goal, self.plan.path
         if self._needs_replan(goal_cell):
-            goal = tuple(float(v) for v in self.context.grid.cell_to_world(*goal_cell))
+            x, y = self.context.grid.cell_to_world(*goal_cell)
+            goal = (float(x), float(y))
             path = self.planner.plan((me.x, me.y), goal).path
             self.follower.set_path(path)
             self._goal_cell = goal_cell

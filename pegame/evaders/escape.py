@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -51,7 +50,7 @@ from pegame.grid import OccupancyGrid, per_grid
 from pegame.grid.cells import cell_centres
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.navigation import Planner
-from pegame.types import Camera, Pose
+from pegame.types import Camera, Pose, Region
 from pegame.visibility import VisibilityRegion, visibility_region
 
 DISTANCES = ("euclidean", "geodesic")
@@ -69,7 +68,8 @@ FIRST_TILES = 4096
 BOUND_SLACK = 1e-9
 
 
-class Escape(NamedTuple):
+@dataclass(frozen=True)
+class Escape:
     """One decision's argmin. cell: flat row-major index (row * width + col) of the goal
     cell, -1 when there is no candidate. cost: its cost_escape (+inf when none). count:
     the number of candidates. sample: flat indices of every
@@ -366,7 +366,7 @@ class EscapeSearch:
         self._half_widths = disc_half_widths(hide_margin, grid.resolution)
         self._component: _Component | None = None
 
-    def escape(self, me: Pose, pursuer: Pose, visible: VisibilityRegion | None = None) -> Escape:
+    def escape(self, me: Pose, pursuer: Pose, visible: Region | None = None) -> Escape:
         """Algorithm 2's argmin for the evader at ``me`` and the pursuer at ``pursuer``:
         the same result as :meth:`escape_reference`, by the kernels (module docstring).
 
@@ -445,8 +445,15 @@ class EscapeSearch:
             dist = np.sqrt((x - pursuer.x) ** 2 + (y - pursuer.y) ** 2)
         else:
             effort = self.planner.distance_field((me.x, me.y)).ravel()[cells]
-            dist = self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()[cells]
+            dist = self.pursuer_distances(pursuer)[cells]
         return escape_costs(effort, dist)
+
+    def pursuer_distances(self, pursuer: Pose) -> np.ndarray:
+        """Float (H * W,): the geodesic distance (m) of each flat cell from the pursuer at
+        ``pursuer`` (geodesic distances only: the pursuer's planner)."""
+        if self.pursuer_planner is None:
+            raise ValueError("Geodesic distances need the pursuer's planner (pursuer_planner).")
+        return self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()
 
     def centres(self, cells) -> np.ndarray:
         """Float (..., 2): the map-frame centres (m) of flat row-major cell indices (an
@@ -464,7 +471,7 @@ class EscapeSearch:
         grid = self.grid
         # Components depend on the traversable cells (the planner's radius) and the stride.
         key = ("evaders.escape", "components", self.planner.radius, self.candidate_stride)
-        shared = per_grid(grid, key, lambda grid: [])
+        shared: list[_Component] = per_grid(grid, key, lambda grid: [])
         row, col = grid.world_to_cell(me.x, me.y)
         on_grid = 0 <= row < grid.height and 0 <= col < grid.width
         source = None
@@ -485,7 +492,7 @@ class EscapeSearch:
         shared.append(self._component)
         return self._component
 
-    def _exposed(self, visible: VisibilityRegion) -> tuple[np.ndarray, int, int]:
+    def _exposed(self, visible: Region) -> tuple[np.ndarray, int, int]:
         """V grown by the hide margin (no candidate lies there) over a window: a bool
         mask, its top row and its left column."""
         r0, r1, c0, c1 = visible.bounds
@@ -501,5 +508,5 @@ class EscapeSearch:
             return bounds, np.zeros(0), np.zeros(0)
         # Path lengths have no useful bound: a cell out of the pursuer's reach costs 0.
         effort = self.planner.distance_field((me.x, me.y)).ravel()
-        dist = self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()
+        dist = self.pursuer_distances(pursuer)
         return np.zeros(component.boxes.shape[0]), effort, dist

@@ -164,7 +164,8 @@ class SmartEvader(Evader):
         cell = divmod(found.cell, self.context.grid.width)
         goal, path = self.plan.goal, self.plan.path
         if self._needs_replan(cell):
-            goal = tuple(float(v) for v in self.search.centres(found.cell))
+            x, y = self.search.centres(found.cell)
+            goal = (float(x), float(y))
             path = self.planner.plan((me.x, me.y), goal).path
             self.follower.set_path(path)
             self._goal_cell = cell
@@ -202,7 +203,7 @@ class SmartEvader(Evader):
             dist = np.min([np.sqrt((x - p.x) ** 2 + (y - p.y) ** 2) for p in pursuers], axis=0)
         else:
             effort = self.planner.distance_field((me.x, me.y)).ravel()[cells]
-            fields = [search.pursuer_planner.distance_field((p.x, p.y)).ravel() for p in pursuers]
+            fields = [search.pursuer_distances(p) for p in pursuers]
             dist = np.min([f[cells] for f in fields], axis=0)
         cost = escape_costs(effort, dist)
         best = int(np.argmin(cost))  # first minimum: the lowest row-major index among ties

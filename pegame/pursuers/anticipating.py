@@ -66,7 +66,7 @@ import numpy as np
 from pegame.api import PursuerObservation
 from pegame.errors import require
 from pegame.pursuers.smart import LOOKAHEAD_TIME, SEARCH, TRACK, SmartPursuer
-from pegame.types import Plan, Pose, Velocity, clamp, wrap_angle
+from pegame.types import Detection, Plan, Pose, Velocity, clamp, wrap_angle
 from pegame.visibility import visibility_region
 
 LOOK = "look"
@@ -121,7 +121,7 @@ class AnticipatingPursuer(SmartPursuer):
 
     def reset(self, pose: Pose) -> None:
         super().reset(pose)
-        self._detection = None  # the last Detection delivered
+        self._detection: Detection | None = None  # the last Detection delivered
         self._seen: tuple[float, float] | None = None  # its position (m)
         self._seen_at = 0.0  # s, when that detection arrived
         self._velocity = (0.0, 0.0)  # m/s, from the last two delivered detections
@@ -165,7 +165,7 @@ class AnticipatingPursuer(SmartPursuer):
         from the previous one. A detector that holds its last result (a rate below the
         control rate) delivers the same Detection object again; that one is not new."""
         detection = observation.detection
-        if detection is self._detection:
+        if detection is None or detection is self._detection:
             return
         position = (float(detection.position[0]), float(detection.position[1]))
         if self._seen is not None:
@@ -179,11 +179,10 @@ class AnticipatingPursuer(SmartPursuer):
 
     def _predicted(self, time: float) -> tuple[float, float]:
         """The evader's position (m) predicted ``lead_time`` s after ``time`` (s)."""
+        seen = self._seen
+        assert seen is not None  # predicted after a detection was noted only
         ahead = time - self._seen_at + self.config.lead_time
-        return (
-            self._seen[0] + ahead * self._velocity[0],
-            self._seen[1] + ahead * self._velocity[1],
-        )
+        return (seen[0] + ahead * self._velocity[0], seen[1] + ahead * self._velocity[1])
 
     def _servo(self, observation: PursuerObservation) -> Velocity:
         """Face the predicted evader and hold the standoff, made collision-safe as the

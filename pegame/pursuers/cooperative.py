@@ -193,14 +193,14 @@ class CooperativePursuer(SmartPursuer):
         """The free pursuers' tasks (module docstring, step 2), in evader order."""
         tasks: list[Task] = []
         for j, belief in enumerate(team.beliefs):
-            seers = [i for i, row in enumerate(team.detections) if row[j] is not None]
+            seers = [(i, d) for i, row in enumerate(team.detections) if (d := row[j]) is not None]
             if seers:
-                tracker = seers[0]
-                me = Pose(*team.detections[tracker][j].position)
+                tracker, detection = seers[0]
+                me = Pose(*detection.position)
                 found = self.escape.escape(me, team.pursuers[tracker], team.union)
                 if found.count:
-                    goal = tuple(float(v) for v in self.escape.centres(found.cell))
-                    tasks.append(Task(goal, self.config.cover_value, j, "cover"))
+                    x, y = self.escape.centres(found.cell)
+                    tasks.append(Task((float(x), float(y)), self.config.cover_value, j, "cover"))
                 continue
             tasks.extend(self._search_tasks(belief, j, free))
         return tasks
@@ -263,6 +263,7 @@ class CooperativePursuer(SmartPursuer):
             self.tracking, self.task = tracked, None
             self.mode = TRACK
             detection = team.detections[team.member][tracked]
+            assert detection is not None  # a tracker detects its evader
             return Plan(goal=detection.position, info={"mode": TRACK, "evader": tracked})
         self.tracking = None
         return self._go(observation, self.assign(team).get(team.member))

@@ -128,6 +128,7 @@ class SmartPursuer(Pursuer):
     def _track(self, observation: PursuerObservation) -> Velocity:
         """The paper's reactive controller on this tick's detection, made collision-safe."""
         detection, body = observation.detection, self.context.pursuer
+        assert detection is not None  # control tracks a detected evader only
         width = self.context.camera.image_width
         offset = (detection.box.x + 0.5 * detection.box.w - 0.5 * width) / width
         w = clamp(-self.config.k_w * offset, body.w_max)
@@ -141,8 +142,9 @@ class SmartPursuer(Pursuer):
     def _detour(self, observation: PursuerObservation, w: float) -> Velocity:
         """Approaching is blocked (the line of sight grazes an obstacle): follow a planned
         path to the detected position instead, as move_base would; turn in place if none."""
-        pose, target = observation.pose, observation.detection.position
-        result = self.planner.plan((pose.x, pose.y), target)
+        pose, detection = observation.pose, observation.detection
+        assert detection is not None  # a detour while tracking a detected evader only
+        result = self.planner.plan((pose.x, pose.y), detection.position)
         if not result.reachable:
             return Velocity(0.0, w)
         self.follower.set_path(result.path)

@@ -64,8 +64,11 @@ def belief_digest() -> str:
     digest = hashlib.sha256()
     while not loop.done:
         loop.advance()
-        digest.update(loop.belief.particles.tobytes())
-        digest.update(loop.belief.weights.tobytes())
+        particles, weights = loop.belief.particles, loop.belief.weights
+        if particles is None or weights is None:
+            raise RuntimeError("The digest needs the particle filter's particles and weights.")
+        digest.update(particles.tobytes())
+        digest.update(weights.tobytes())
     return digest.hexdigest()
 
 

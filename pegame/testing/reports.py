@@ -7,6 +7,7 @@ from __future__ import annotations
 import hashlib
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -92,11 +93,11 @@ PROVENANCE = {
 }
 
 
-def job_config(**settings) -> dict:
+def job_config(**settings: Any) -> dict[str, Any]:
     """A resolved job config (no game.seed, game.trials, resume, hydra) with dotted
     ``settings`` applied, e.g. ``job_config(**{"detector.miss_probability": 0.3})``; a value
     None removes the key."""
-    config = {
+    config: dict[str, Any] = {
         "game": {"t_max": 20.0, "control_hz": 10.0, "decision_hz": 1.0, "speed_ratio": 1.0},
         "env": {"name": "enclosed", "map": "enclosed.yaml"},
         "sim": {"name": "grid"},
@@ -122,10 +123,10 @@ def config_game(
     seed: int,
     rate: float,
     overrides: tuple[str, ...] = (),
-    provenance: dict | None = PROVENANCE,
+    provenance: dict[str, Any] | None = PROVENANCE,
     kind: str = "game",
-    **settings,
-) -> dict:
+    **settings: Any,
+) -> dict[str, Any]:
     """A game (or failed) line of the contract: today's fields plus config, config_hash,
     overrides and provenance."""
     config = job_config(**settings)
@@ -160,7 +161,7 @@ def config_game(
     }
 
 
-def config_job(root: Path, name: str, seeds: range, rates: list[float], **settings) -> Path:
+def config_job(root: Path, name: str, seeds: range, rates: list[float], **settings: Any) -> Path:
     """A job of the games ``seeds`` with ``rates``, all of one configuration."""
     overrides = [f"{k}={v}" for k, v in settings.items()]
     return write_job(

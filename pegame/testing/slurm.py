@@ -20,6 +20,7 @@ import shutil
 import socket
 import subprocess
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -86,6 +87,14 @@ def _which(name: str) -> str | None:
     return shutil.which(name, path=search)
 
 
+def _executable(name: str) -> str:
+    """The path of ``name`` (:func:`_which`); SlurmUnavailable when it is not installed."""
+    path = _which(name)
+    if path is None:
+        raise SlurmUnavailable(f"{name} is not installed (on PATH or in sbin).")
+    return path
+
+
 def missing_executables() -> list[str]:
     """The executables of :data:`EXECUTABLES` that are not installed."""
     return [name for name in EXECUTABLES if _which(name) is None]
@@ -106,7 +115,7 @@ def _free_ports(count: int) -> list[int]:
 def _node_hardware() -> tuple[int, int]:
     """(CPUs, RealMemory in MiB) of this host as slurmd sees it (``slurmd -C``)."""
     out = subprocess.run(
-        [_which("slurmd"), "-C"], capture_output=True, text=True, timeout=30, check=False
+        [_executable("slurmd"), "-C"], capture_output=True, text=True, timeout=30, check=False
     ).stdout
     fields = dict(word.split("=", 1) for word in out.split() if "=" in word)
     try:
@@ -166,7 +175,9 @@ def _start(cluster: SlurmCluster, name: str, *command: str) -> None:
     log.close()
 
 
-def _wait_for(cluster: SlurmCluster, what: str, ready, timeout_s: float) -> None:
+def _wait_for(
+    cluster: SlurmCluster, what: str, ready: Callable[[], bool], timeout_s: float
+) -> None:
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         if ready():
@@ -215,14 +226,14 @@ def start_cluster(root: Path, timeout_s: float = 60.0) -> SlurmCluster:
         # --force: munged would refuse a key or socket below a directory others can write
         # (a custom --basetemp, say); this key guards a throwaway cluster.
         _start(
-            cluster, "munged", _which("munged"), "--foreground", "--force",
+            cluster, "munged", _executable("munged"), "--foreground", "--force",
             f"--socket={root / 'munge.socket'}", f"--key-file={key}",
             f"--pid-file={root / 'munged.pid'}", f"--log-file={root / 'munged.log'}",
             f"--seed-file={root / 'munged.seed'}",
         )  # fmt: skip
         _wait_for(cluster, "munged's socket", (root / "munge.socket").exists, timeout_s)
-        _start(cluster, "slurmctld", _which("slurmctld"), "-D", "-i", "-f", str(cluster.conf))
-        _start(cluster, "slurmd", _which("slurmd"), "-D", "-f", str(cluster.conf))
+        _start(cluster, "slurmctld", _executable("slurmctld"), "-D", "-i", "-f", str(cluster.conf))
+        _start(cluster, "slurmd", _executable("slurmd"), "-D", "-f", str(cluster.conf))
 
         def node_idle() -> bool:
             state = cluster.run("sinfo", "-h", "-n", node, "-o", "%t", timeout_s=10).stdout
