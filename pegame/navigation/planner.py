@@ -26,7 +26,17 @@ from scipy import ndimage
 from pegame.errors import require
 from pegame.grid import OccupancyGrid, per_grid, read_only
 from pegame.navigation.inflation import DISTANCE_TOLERANCE, shared_obstacle_distance
-from pegame.navigation.search import MOVES, allowed_moves, astar, dijkstra, pad_flat
+from pegame.navigation.search import (
+    MOVES,
+    AStarScratch,
+    BucketPool,
+    Heuristic,
+    Lattice,
+    allowed_moves,
+    astar,
+    dijkstra,
+    pad_flat,
+)
 
 #: grids with at least this many cells round A*'s keys by default (see Planner); the
 #: paper's maps have at most 120 000
@@ -138,9 +148,12 @@ class Planner:
         self._nearest: np.ndarray | None = None  # see _nearest_cells
         self._padded_width = grid.width + 2
         self._allowed = allowed_moves(self.traversable)
+        self._lattice = Lattice(
+            self._allowed, self._padded_multipliers, grid.resolution, self._padded_width, MOVES
+        )
         # Search scratch memory, allocated at the first search that needs it.
-        self._astar_scratch: tuple[np.ndarray, ...] | None = None
-        self._bucket_pool: tuple[np.ndarray, np.ndarray] | None = None
+        self._astar_scratch: AStarScratch | None = None
+        self._bucket_pool: BucketPool | None = None
         self.landmarks = int(landmarks)
         if tie_quantum is None:
             tie_quantum = TIE_QUANTUM if grid.data.size >= LARGE_GRID_CELLS else 0.0
@@ -219,20 +232,11 @@ class Planner:
             if self._bucket_pool is None:
                 # Cells usually enter the queue about once; start at 2 n + 1 entries and
                 # grow to the bound 8 n + 1 only if a search runs out.
-                self._bucket_pool = (np.empty(2 * n + 1, np.int32), np.empty(2 * n + 1, np.int32))
-            dist, complete = dijkstra(
-                self._allowed,
-                self._padded_multipliers,
-                weighted,
-                self.grid.resolution,
-                self._padded_width,
-                self._flat(cell),
-                MOVES,
-                *self._bucket_pool,
-            )
+                self._bucket_pool = BucketPool.empty(2 * n + 1)
+            dist, complete = dijkstra(self._lattice, weighted, self._flat(cell), self._bucket_pool)
             if complete:
                 return dist.reshape(self.grid.height + 2, self._padded_width)[1:-1, 1:-1]
-            self._bucket_pool = (np.empty(8 * n + 1, np.int32), np.empty(8 * n + 1, np.int32))
+            self._bucket_pool = BucketPool.empty(8 * n + 1)
 
     def _landmark_table(self) -> np.ndarray:
         """Float32 (landmarks, n): weighted path costs (m) from each landmark cell to every
@@ -276,22 +280,12 @@ class Planner:
             self._landmarks = read_only(costs)
         return self._landmarks
 
-    def _search_scratch(self) -> tuple[np.ndarray, ...]:
-        """A*'s scratch arrays (g, parent, keys, ties, nodes, pos, touched, seen), seen all
-        False between searches. All are left uninitialised or zeroed by the system (see
-        search.astar), so a search uses the memory of the cells it reaches only."""
+    def _search_scratch(self) -> AStarScratch:
+        """A*'s scratch arrays, seen all False between searches. All are left uninitialised
+        or zeroed by the system (see search.astar), so a search uses the memory of the
+        cells it reaches only."""
         if self._astar_scratch is None:
-            n = self._allowed.size
-            self._astar_scratch = (
-                np.empty(n),
-                np.empty(n, np.int32),
-                np.empty(n),
-                np.empty(n),
-                np.empty(n, np.int32),
-                np.empty(n, np.int32),
-                np.empty(n, np.int32),
-                np.zeros(n, np.bool_),
-            )
+            self._astar_scratch = AStarScratch.empty(self._allowed.size)
         return self._astar_scratch
 
     def _snap_goal(self, goal_xy, label: int) -> tuple[int, int] | None:
@@ -340,17 +334,9 @@ class Planner:
                 if not self.grid.contains(row, col):
                     return _unreachable("goal is outside the map")
                 return _unreachable("goal is inside an obstacle")
+        heuristic = Heuristic(self._landmark_table(), self.tie_quantum)
         cost, cells, searched = astar(
-            self._allowed,
-            self._padded_multipliers,
-            self.grid.resolution,
-            self._padded_width,
-            self._flat(start),
-            self._flat(goal),
-            MOVES,
-            self._landmark_table(),
-            self.tie_quantum,
-            *self._search_scratch(),
+            self._lattice, self._flat(start), self._flat(goal), heuristic, self._search_scratch()
         )
         rows, cols = np.divmod(cells, self._padded_width)
         x, y = self.grid.cell_to_world(rows - 1, cols - 1)

@@ -13,13 +13,16 @@ as one bit per move (:func:`allowed_moves`), so a search reads one byte per cell
 of up to three traversable flags per move. :func:`dijkstra` is Dijkstra's algorithm with
 a bucket queue, :func:`astar` A* with an indexed binary heap; the plain-Python
 :func:`distance_field_reference` and :func:`astar_reference` (heapq on (row, col) cells)
-implement the same algorithms for the tests to compare against.
+implement the same algorithms for the tests to compare against. The kernels take their
+arrays grouped by meaning (:class:`Lattice`, :class:`Heuristic`, :class:`AStarScratch`,
+:class:`BucketPool`) and unpack them once at entry.
 """
 
 from __future__ import annotations
 
 import heapq
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -30,6 +33,56 @@ SQRT2 = math.sqrt(2.0)
 MOVES = np.array(
     [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)], dtype=np.int64
 )
+
+
+class Lattice(NamedTuple):
+    """The padded grid as the search kernels walk it."""
+
+    allowed: np.ndarray  # uint8 per flat padded cell: bit k set when move k is allowed
+    multipliers: np.ndarray  # float64 per flat padded cell: step cost multiplier, >= 1
+    resolution: float  # m, the cells' edge
+    padded_width: int  # cells per padded row
+    moves: np.ndarray  # int64 (8, 2), the (row, col) steps of the bits: MOVES
+
+
+class Heuristic(NamedTuple):
+    """A*'s lower bound and key rounding (see :func:`astar`)."""
+
+    landmark_costs: np.ndarray  # float32 (K, n) scaled costs from K landmarks; K may be 0
+    tie_quantum: float  # m; keys rounded down to multiples of it, 0: exact keys
+
+
+class AStarScratch(NamedTuple):
+    """A*'s scratch arrays, one entry per flat padded cell (see :func:`astar`)."""
+
+    g: np.ndarray  # float64, cost from the start (m)
+    parent: np.ndarray  # int32, the cell a cell was reached from
+    keys: np.ndarray  # float64, the heap's keys
+    ties: np.ndarray  # float64, the heap's tie breaks
+    nodes: np.ndarray  # int32, the heap's cells
+    pos: np.ndarray  # int32, a cell's heap slot
+    touched: np.ndarray  # int32, the cells a search reached, in order
+    seen: np.ndarray  # bool, all False between searches
+
+    @classmethod
+    def empty(cls, n: int) -> AStarScratch:
+        """Scratch for ``n`` cells, uninitialised but ``seen`` (all False)."""
+        floats, ints = (np.empty(n) for _ in range(3)), (np.empty(n, np.int32) for _ in range(4))
+        g, keys, ties = floats
+        parent, nodes, pos, touched = ints
+        return cls(g, parent, keys, ties, nodes, pos, touched, np.zeros(n, np.bool_))
+
+
+class BucketPool(NamedTuple):
+    """Dijkstra's bucket entries (see :func:`dijkstra`): int32, the same length."""
+
+    cell: np.ndarray  # the entry's flat cell
+    next: np.ndarray  # the next entry in its bucket, -1 at the end
+
+    @classmethod
+    def empty(cls, size: int) -> BucketPool:
+        """A pool of ``size`` entries (8 n + 1 always suffice for n cells)."""
+        return cls(np.empty(size, np.int32), np.empty(size, np.int32))
 
 
 def pad_flat(array: np.ndarray, fill) -> np.ndarray:
@@ -70,20 +123,21 @@ def allowed_moves(traversable: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def dijkstra(
-    allowed, multipliers, weighted, resolution, padded_width, source, moves, entry_cell, entry_next
-):
-    """Least path cost (m) from flat cell ``source`` to every cell; inf if unreachable.
+def dijkstra(lattice, weighted, source, pool):
+    """Least path cost (m) over ``lattice`` from flat cell ``source`` to every cell, inf if
+    unreachable; each step's length times its cells' mean multiplier when ``weighted``.
 
     Dijkstra with a bucket queue (Dinitz's variant of Dial's algorithm): bucket b holds
     cells with cost in [b w, (b+1) w) for a width w no larger than the cheapest move, so
     no cell can improve another in its own bucket and every cell of the lowest bucket is
     final. This gives the same costs as a binary heap at a fraction of the time. Buckets
-    are singly linked lists in the entry pool ``entry_cell``/``entry_next`` (scratch, int32)
-    kept on a ring; a cell whose cost drops is added again and its older entries are
-    skipped. Returns (costs, True), or (partial costs, False) when the pool was too small
-    (a cell enters it at most once per neighbour, so 8 n + 1 entries always suffice).
+    are singly linked lists in the entry ``pool`` (scratch) kept on a ring; a cell whose
+    cost drops is added again and its older entries are skipped. Returns (costs, True), or
+    (partial costs, False) when the pool was too small (a cell enters it at most once per
+    neighbour, so 8 n + 1 entries always suffice).
     """
+    allowed, multipliers, resolution, padded_width, moves = lattice
+    entry_cell, entry_next = pool
     n = allowed.size
     offsets, lengths = _move_tables(padded_width, moves, resolution)
     max_step = resolution * SQRT2 * (multipliers.max() if weighted else 1.0)
@@ -202,31 +256,13 @@ def _octile(resolution, row, col, goal_row, goal_col):
 
 
 @njit(cache=True)
-def astar(
-    allowed,
-    multipliers,
-    resolution,
-    padded_width,
-    start,
-    goal,
-    moves,
-    landmark_costs,
-    tie_quantum,
-    g,
-    parent,
-    keys,
-    ties,
-    nodes,
-    pos,
-    touched,
-    seen,
-):
-    """Minimum weighted cost (m), flat cell path and number of cells reached from
-    ``start`` to ``goal`` by A*.
+def astar(lattice, start, goal, heuristic, scratch):
+    """Minimum weighted cost (m), flat cell path and number of cells reached over
+    ``lattice`` from flat cell ``start`` to ``goal`` by A*.
 
     The heuristic is the octile distance, admissible and consistent because every
-    multiplier is >= 1, or the larger landmark bound when ``landmark_costs`` (K, n) has
-    rows (see ``Planner._landmark_table``). Returns (inf, empty, reached) when the goal is
+    multiplier is >= 1, or the larger landmark bound when ``heuristic.landmark_costs``
+    (K, n) has rows (see ``Planner._landmark_table``). Returns (inf, empty, reached) when the goal is
     unreachable.
 
     The heap orders cells by f = g + h, then by the smaller h. With ``tie_quantum`` q > 0
@@ -241,13 +277,16 @@ def astar(
     The cost found is optimal to within q per step of the path. q = 0 keeps the exact key
     and no closed set (the paper maps' searches).
 
-    The other arrays (length n) are scratch. ``seen`` (bool) must be all False on entry
+    The ``scratch`` arrays have length n. ``seen`` (bool) must be all False on entry
     and is restored before returning (only the ``touched`` cells are reset, not the whole
     grid); the others are read only where ``seen`` is set (a cell's g, heap slot and
     parent are written when the search first reaches it), so they may be allocated
     uninitialised and only the memory pages of the cells a search reaches are ever
     used: on a large map a short search costs little memory.
     """
+    allowed, multipliers, resolution, padded_width, moves = lattice
+    landmark_costs, tie_quantum = heuristic
+    g, parent, keys, ties, nodes, pos, touched, seen = scratch
     offsets, lengths = _move_tables(padded_width, moves, resolution)
     goal_row, goal_col = goal // padded_width, goal % padded_width
     to_goal = landmark_costs[:, goal].copy()

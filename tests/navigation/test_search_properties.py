@@ -19,6 +19,10 @@ from pegame.navigation import TIE_QUANTUM
 from pegame.navigation.search import (
     MOVES,
     SQRT2,
+    AStarScratch,
+    BucketPool,
+    Heuristic,
+    Lattice,
     allowed_moves,
     astar,
     astar_reference,
@@ -39,6 +43,7 @@ class Search:
         self.width = traversable.shape[1] + 2  # padded
         self.allowed = allowed_moves(traversable)
         self.padded_multipliers = pad_flat(multipliers, 1.0)
+        self.lattice = Lattice(self.allowed, self.padded_multipliers, resolution, self.width, MOVES)
 
     def flat(self, cell: Cell) -> int:
         return (cell[0] + 1) * self.width + cell[1] + 1
@@ -48,33 +53,18 @@ class Search:
 
     def distance_field(self, source: Cell, weighted: bool) -> np.ndarray:
         """The kernel's costs (H, W) from ``source``, with a pool that always suffices."""
-        n = self.allowed.size
-        pool = (np.empty(8 * n + 1, np.int32), np.empty(8 * n + 1, np.int32))
-        args = (self.padded_multipliers, weighted, self.resolution, self.width)
-        dist, complete = dijkstra(self.allowed, *args, self.flat(source), MOVES, *pool)
+        pool = BucketPool.empty(8 * self.allowed.size + 1)
+        dist, complete = dijkstra(self.lattice, weighted, self.flat(source), pool)
         assert complete
         return dist.reshape(-1, self.width)[1:-1, 1:-1]
 
     def astar(self, start: Cell, goal: Cell, tie_quantum: float) -> tuple[float, list[Cell]]:
         """A*'s cost and (row, col) path, checking that it restores its ``seen`` scratch."""
         n = self.allowed.size
-        seen = np.zeros(n, np.bool_)
-        scratch = [np.empty(n), np.empty(n, np.int32), np.empty(n), np.empty(n)]
-        scratch += [np.empty(n, np.int32) for _ in range(3)]
-        cost, path, _ = astar(
-            self.allowed,
-            self.padded_multipliers,
-            self.resolution,
-            self.width,
-            self.flat(start),
-            self.flat(goal),
-            MOVES,
-            np.zeros((0, n), np.float32),
-            tie_quantum,
-            *scratch,
-            seen,
-        )
-        assert not seen.any()
+        scratch = AStarScratch.empty(n)
+        heuristic = Heuristic(np.zeros((0, n), np.float32), tie_quantum)
+        cost, path, _ = astar(self.lattice, self.flat(start), self.flat(goal), heuristic, scratch)
+        assert not scratch.seen.any()
         return float(cost), [self.cell(int(p)) for p in path]
 
     def step(self, a: Cell, b: Cell) -> float:
