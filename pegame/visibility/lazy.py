@@ -10,12 +10,15 @@ the whole mask: the same rays are sampled at the same points (:mod:`pegame.visib
 and stop at the same blocked sample, and no other sample can land in the block.
 
 Units and frames: metres and radians in the map frame of :mod:`pegame.grid`; cells are
-flat row-major indices row * width + col, or (row, col).
+flat row-major indices row * width + col, or (row, col). The kernels take the grid, the
+camera's pose and its rays as :class:`Sight`, :class:`Eye` and :class:`Rays`, and a block
+of cells as (row0, row1, col0, col1), unpacked once at entry.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -26,6 +29,34 @@ from pegame.numerics import wrap_angle_kernel
 from pegame.types import Camera, Pose
 from pegame.visibility.rays import directions, ray_tables
 from pegame.visibility.region import MaskRegion, lookup, march, whole_region
+
+
+class Sight(NamedTuple):
+    """The grid as the ray kernels see it."""
+
+    blocked: np.ndarray  # bool (H, W), the cells that stop a ray
+    frame: tuple  # OccupancyGrid.kernel_frame
+    yaw: float  # rad, the grid's rotation in the map frame
+
+
+class Eye(NamedTuple):
+    """The camera's pose (map frame)."""
+
+    x: float  # m
+    y: float  # m
+    theta: float  # rad, the heading
+
+
+class Rays(NamedTuple):
+    """The camera's rays and their samples (:func:`pegame.visibility.rays.ray_tables`)."""
+
+    angles: np.ndarray  # rad from the heading, increasing
+    distances: np.ndarray  # m along a ray of each sample
+    first: int  # the first sample that counts (at the near plane)
+    angle_step: float  # rad between rays
+    distance_step: float  # m between samples
+    fov: float  # rad, the field of view
+    far: float  # m, the range
 
 
 class VisibilityRegion:
@@ -70,7 +101,7 @@ class VisibilityRegion:
         rows[1] and cols[0] <= col <= cols[1], and False or equal to it elsewhere."""
         if self._whole is not None:
             return self._whole.mask
-        return _mask_over(*self._kernel_arguments(), rows[0], rows[1], cols[0], cols[1])
+        return _mask_over(*self._kernel_arguments(), (rows[0], rows[1], cols[0], cols[1]))
 
     def holds(self, cells: np.ndarray) -> np.ndarray:
         """Bool (N,): whether the region holds each of the flat cell indices ``cells`` (N,)
@@ -84,66 +115,33 @@ class VisibilityRegion:
             return self._whole.holds(cells)
         return _holds(np.asarray(cells, dtype=np.int64), *self._kernel_arguments())
 
-    def _kernel_arguments(self) -> tuple:
+    def _kernel_arguments(self) -> tuple[Sight, Eye, Rays]:
         """The grid, pose and camera as :func:`_mask_over` and :func:`_holds` take them."""
         grid, pose, camera = self.grid, self.pose, self.camera
         angles, distances, first = ray_tables(camera)
         return (
-            grid.blocked,
-            grid.kernel_frame,
-            float(grid.origin[2]),
-            float(pose.x),
-            float(pose.y),
-            float(pose.theta),
-            angles,
-            distances,
-            first,
-            camera.angle_step,
-            camera.distance_step,
-            camera.fov,
-            camera.far,
+            Sight(grid.blocked, grid.kernel_frame, float(grid.origin[2])),
+            Eye(float(pose.x), float(pose.y), float(pose.theta)),
+            Rays(
+                angles,
+                distances,
+                first,
+                camera.angle_step,
+                camera.distance_step,
+                camera.fov,
+                camera.far,
+            ),
         )
 
 
 @njit(cache=True)
-def _mask_over(
-    blocked,
-    frame,
-    yaw,
-    px,
-    py,
-    theta,
-    angles,
-    distances,
-    first,
-    angle_step,
-    distance_step,
-    fov,
-    far,
-    row0,
-    row1,
-    col0,
-    col1,
-):
-    """Kernel of :meth:`VisibilityRegion.mask_over`: march the rays reaching the block."""
-    ox, oy, resolution = frame[OX], frame[OY], frame[RESOLUTION]
-    i0, i1, samples = _rays_reaching(
-        angles,
-        angle_step,
-        distance_step,
-        distances.size,
-        px,
-        py,
-        theta,
-        ox,
-        oy,
-        yaw,
-        resolution,
-        row0,
-        row1,
-        col0,
-        col1,
-    )
+def _mask_over(sight, eye, rays, block):
+    """Kernel of :meth:`VisibilityRegion.mask_over`: march the rays reaching the block
+    (row0, row1, col0, col1) of cells."""
+    blocked, frame, yaw = sight
+    px, py, theta = eye
+    angles, distances, first, _, _, _, _ = rays
+    i0, i1, samples = _rays_reaching(rays, eye, frame, yaw, block)
     mask = np.zeros(blocked.shape, dtype=np.bool_)
     if i1 > i0 and samples > first:
         cos_a, sin_a = directions(theta, angles, i0, i1)
@@ -152,48 +150,13 @@ def _mask_over(
 
 
 @njit(cache=True)
-def _holds(
-    cells,
-    blocked,
-    frame,
-    yaw,
-    px,
-    py,
-    theta,
-    angles,
-    distances,
-    first,
-    angle_step,
-    distance_step,
-    fov,
-    far,
-):
+def _holds(cells, sight, eye, rays):
     """Kernel of :meth:`VisibilityRegion.holds` for a region not yet computed whole."""
-    ox, oy, resolution = frame[OX], frame[OY], frame[RESOLUTION]
-    near, (r0, r1, c0, c1) = _near_wedge(
-        cells, blocked.shape[1], px, py, theta, ox, oy, yaw, resolution, fov, far
-    )
-    if r1 < r0:
+    blocked, frame, yaw = sight
+    near, block = _near_wedge(cells, blocked.shape[1], eye, frame, yaw, rays.fov, rays.far)
+    if block[1] < block[0]:
         return near  # all False
-    mask = _mask_over(
-        blocked,
-        frame,
-        yaw,
-        px,
-        py,
-        theta,
-        angles,
-        distances,
-        first,
-        angle_step,
-        distance_step,
-        fov,
-        far,
-        r0,
-        r1,
-        c0,
-        c1,
-    )
+    mask = _mask_over(sight, eye, rays, block)
     return lookup(mask.ravel(), cells, near)
 
 
@@ -206,13 +169,15 @@ def _in_cells(x, y, ox, oy, yaw, resolution):
 
 
 @njit(cache=True)
-def _near_wedge(cells, width, px, py, theta, ox, oy, yaw, resolution, fov, far):
+def _near_wedge(cells, width, eye, frame, yaw, fov, far):
     """(near (N,) bool, (row min, row max, col min, col max) of the near cells): which flat
-    cell indices (negative: none) have their centre within half a cell diagonal (plus a
-    rounding margin) of the field of view's wedge, apex (px, py) (map frame, m), heading
-    theta, opening fov, radius far (m). A cell farther away cannot hold a ray sample of
-    Algorithm 1. For fov > pi every cell within range is near. The bounds are (0, -1,
-    0, -1) when no cell is near."""
+    cell indices (negative: none) of a grid ``width`` cells wide (``frame``, rotated by
+    ``yaw``) have their centre within half a cell diagonal (plus a rounding margin) of the
+    field of view's wedge, apex and heading the ``eye``'s, opening fov, radius far (m). A
+    cell farther away cannot hold a ray sample of Algorithm 1. For fov > pi every cell
+    within range is near. The bounds are (0, -1, 0, -1) when no cell is near."""
+    px, py, theta = eye
+    ox, oy, resolution = frame[OX], frame[OY], frame[RESOLUTION]
     u, v = _in_cells(px, py, ox, oy, yaw, resolution)
     heading = theta - yaw  # in the grid frame
     left_u, left_v = math.cos(heading + 0.5 * fov), math.sin(heading + 0.5 * fov)
@@ -249,29 +214,19 @@ _REACH_MARGIN = 0.5
 
 
 @njit(cache=True)
-def _rays_reaching(
-    angles,
-    angle_step,
-    distance_step,
-    n_distances,
-    px,
-    py,
-    theta,
-    ox,
-    oy,
-    yaw,
-    resolution,
-    row0,
-    row1,
-    col0,
-    col1,
-):
-    """(first ray, stop ray, samples): the camera's rays angles[first:stop] (rad from the
-    heading theta) and the number of samples along each (from the first) that can land in
-    the block of cells row0..row1 x col0..col1 (inclusive), seen from (px, py) (map frame,
-    m). The block is grown by _REACH_MARGIN cells, and one ray and one sample more are
-    taken on every side, so rounding at cell edges cannot hide a sample.
+def _rays_reaching(rays, eye, frame, yaw, block):
+    """(first ray, stop ray, samples): the ``rays`` angles[first:stop] (rad from the
+    ``eye``'s heading theta) and the number of samples along each (from the first) that
+    can land in the block of cells row0..row1 x col0..col1 (inclusive) of a grid
+    (``frame``, rotated by ``yaw``), seen from the eye. The block is grown by
+    _REACH_MARGIN cells, and one ray and one sample more are taken on every side, so
+    rounding at cell edges cannot hide a sample.
     """
+    angles, distances, _, angle_step, distance_step, _, _ = rays
+    n_distances = distances.size
+    px, py, theta = eye
+    ox, oy, resolution = frame[OX], frame[OY], frame[RESOLUTION]
+    row0, row1, col0, col1 = block
     u, v = _in_cells(px, py, ox, oy, yaw, resolution)
     us = (col0 - _REACH_MARGIN - u, col1 + 1 + _REACH_MARGIN - u)
     vs = (row0 - _REACH_MARGIN - v, row1 + 1 + _REACH_MARGIN - v)
