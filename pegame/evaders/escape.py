@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -191,43 +192,54 @@ def _cell_centre(row, col, frame):
     return u + frame[OX], v + frame[OY]
 
 
-@njit(cache=True)
-def _best_candidate(
-    tiles,
-    bounds,
-    starts,
-    rows,
-    cols,
-    frame,
-    grid_width,
-    exposed,
-    top,
-    left,
-    agents,
-    effort,
-    dist,
-    best_cell,
-    best_cost,
-):
-    """Algorithm 2's argmin over the unexposed cells of ``tiles`` and the best (flat cell,
-    cost) found before them ((-1, inf) for none): (flat cell, cost, stopped), stopped
-    when a tile's bound ended the search before the last tile.
+class TiledCells(NamedTuple):
+    """A component's candidate cells grouped by tile (:func:`_group_by_tile`), on their grid."""
 
-    Cells come grouped by tile (tile t holds entries starts[t] to starts[t + 1]) as rows
-    and columns of the grid of ``grid_width`` columns and map-to-cell transform ``frame``
-    (``OccupancyGrid.kernel_frame``); ``tiles`` lists the tiles by increasing bound.
-    ``agents`` is (evader x, evader y, pursuer x, pursuer y) (m). With flat distance
-    fields ``effort`` and ``dist`` (m) the costs come from them, else from Euclidean
-    distances computed as :meth:`EscapeSearch.costs` does.
+    starts: np.ndarray  # int64 (T + 1,), where each tile's cells begin in rows and cols
+    rows: np.ndarray  # int32 (K,), the cells' rows, grouped by tile
+    cols: np.ndarray  # int32 (K,), their columns
+    frame: tuple  # the grid's OccupancyGrid.kernel_frame
+    grid_width: int  # the grid's columns
+
+
+class Window(NamedTuple):
+    """Cells of the grid in a window: a bool block placed at (top, left)."""
+
+    cells: np.ndarray  # bool (h, w)
+    top: int  # the window's first row in the grid
+    left: int  # its first column
+
+
+class Costs(NamedTuple):
+    """What Algorithm 2's cost effort / dist of a cell is computed from."""
+
+    agents: tuple[float, float, float, float]  # (evader x, evader y, pursuer x, pursuer y), m
+    effort: np.ndarray  # float (H * W,) the evader's path costs (m), or empty: Euclidean
+    dist: np.ndarray  # float (H * W,) the pursuer's, or empty
+
+
+@njit(cache=True)
+def _best_candidate(tiles, bounds, cells, exposed, costs, best):
+    """Algorithm 2's argmin over the ``cells`` of ``tiles`` outside the ``exposed`` window
+    and the ``best`` (flat cell, cost) found before them ((-1, inf) for none): (flat cell,
+    cost, stopped), stopped when a tile's bound ended the search before the last tile.
+
+    ``tiles`` lists the tiles by increasing bound, ``bounds`` (T,) the bounds. With flat
+    distance fields ``costs.effort`` and ``costs.dist`` (m) the costs come from them, else
+    from Euclidean distances computed as :meth:`EscapeSearch.costs` does.
     """
+    starts, rows, cols, frame, grid_width = cells
+    window, top, left = exposed
+    agents, effort, dist = costs
+    best_cell, best_cost = best
     ex, ey, px, py = agents
-    height, width = exposed.shape
+    height, width = window.shape
     for t in tiles:
         if bounds[t] > best_cost * (1.0 + BOUND_SLACK):
             return best_cell, best_cost, True
         for k in range(starts[t], starts[t + 1]):
             row, col = rows[k] - top, cols[k] - left
-            if 0 <= row < height and 0 <= col < width and exposed[row, col]:
+            if 0 <= row < height and 0 <= col < width and window[row, col]:
                 continue
             cell = rows[k] * grid_width + cols[k]
             if effort.size:
@@ -385,17 +397,11 @@ class EscapeSearch:
         bounds, effort, dist = self._bounds(component, me, pursuer)
         arguments = (
             bounds,
-            component.starts,
-            component.rows,
-            component.cols,
-            grid.kernel_frame,
-            grid.width,
-            exposed,
-            top,
-            left,
-            (me.x, me.y, pursuer.x, pursuer.y),
-            effort,
-            dist,
+            TiledCells(
+                component.starts, component.rows, component.cols, grid.kernel_frame, grid.width
+            ),
+            Window(exposed, top, left),
+            Costs((me.x, me.y, pursuer.x, pursuer.y), effort, dist),
         )
         # Tiles in increasing bound, the FIRST_TILES lowest sorted first: the search
         # nearly always stops among them, and sorting every tile of a large map is most
@@ -406,10 +412,10 @@ class EscapeSearch:
         else:
             first, rest = np.arange(bounds.size), np.zeros(0, dtype=np.int64)
         first = first[np.argsort(bounds[first])]
-        cell, cost, stopped = _best_candidate(first, *arguments, -1, math.inf)
+        cell, cost, stopped = _best_candidate(first, *arguments, (-1, math.inf))
         if not stopped and rest.size:
             rest = rest[np.argsort(bounds[rest])]
-            cell, cost, stopped = _best_candidate(rest, *arguments, cell, cost)
+            cell, cost, stopped = _best_candidate(rest, *arguments, (cell, cost))
         step = _sample_step(count, MAX_RECORDED_CANDIDATES)
         sample = component.cells[_sample_positions(skipped, count, step)].astype(np.int64)
         return Escape(int(cell), float(cost), count, sample)
