@@ -73,10 +73,11 @@ def free_poses(grid: OccupancyGrid, radius: float, n: int, seed: int = 0) -> lis
     rng = np.random.default_rng(seed)
     rows, cols = np.nonzero(Planner.shared(grid, radius).traversable)
     picks = rng.integers(rows.size, size=n)
-    return [
-        Pose(*grid.cell_to_world(rows[k], cols[k]), float(rng.uniform(-math.pi, math.pi)))
-        for k in picks
-    ]
+    poses = []
+    for k in picks:
+        x, y = grid.cell_to_world(rows[k], cols[k])
+        poses.append(Pose(x, y, float(rng.uniform(-math.pi, math.pi))))
+    return poses
 
 
 def bench_visibility(grid: OccupancyGrid, repeat: int) -> float:

@@ -44,7 +44,8 @@ def check_seed(seed: int | None) -> int | None:
 
 def game_seed(seed: int | None, rng: np.random.Generator) -> int:
     """``seed`` itself when given (checked), else a fresh one drawn from ``rng``."""
-    return int(rng.integers(2**63 - 1)) if check_seed(seed) is None else int(seed)
+    checked = check_seed(seed)
+    return int(rng.integers(2**63 - 1)) if checked is None else int(checked)
 
 
 class EnvGame:
@@ -65,9 +66,11 @@ class EnvGame:
         self.scenario = Scenario(cfg)
         context = self.scenario.context
         self.ticks_per_action = settings.ticks_per_action(context.control_dt)
-        self.features = {
-            "pursuer": PursuerFeatures(context, settings.observation),
-            "evader": EvaderFeatures(context, settings.observation),
+        pursuer_features = PursuerFeatures(context, settings.observation)
+        evader_features = EvaderFeatures(context, settings.observation)
+        self.features: dict[str, PursuerFeatures | EvaderFeatures] = {
+            "pursuer": pursuer_features,
+            "evader": evader_features,
         }
         self.bodies = {"pursuer": context.pursuer, "evader": context.evader}
         sizes = dict(zip(("pursuer", "evader"), self.scenario.team_size))
@@ -78,23 +81,25 @@ class EnvGame:
             for role in self.roles
         }
         self.agents = [agent for role in self.roles for agent in self.members[role]]
-        self.member_features = {
-            agent: self.features[role]
-            if solo
-            else type(self.features[role])(context, settings.observation)
-            for role in self.roles
-            for agent in self.members[role]
-        }
         #: (agent, pursuer index i, its target evader i mod M, features) per learning pursuer
         self._pursuer_agents = [
-            (agent, i, i % sizes["evader"], self.member_features[agent])
+            (
+                agent,
+                i,
+                i % sizes["evader"],
+                pursuer_features if solo else PursuerFeatures(context, settings.observation),
+            )
             for i, agent in enumerate(self.members.get("pursuer", ()))
         ]
         #: (agent, evader index j, features) per learning evader
         self._evader_agents = [
-            (agent, j, self.member_features[agent])
+            (agent, j, evader_features if solo else EvaderFeatures(context, settings.observation))
             for j, agent in enumerate(self.members.get("evader", ()))
         ]
+        self.member_features: dict[str, PursuerFeatures | EvaderFeatures] = {
+            **{agent: features for agent, _, _, features in self._pursuer_agents},
+            **{agent: features for agent, _, features in self._evader_agents},
+        }
         #: (role, body, [(agent, name in errors)]) per learning role; a 1v1 game's roles
         #: are commanded with one velocity each, a team's with one per member
         self._actors = [
@@ -152,24 +157,30 @@ class EnvGame:
     def observations(self) -> dict[str, np.ndarray]:
         """Each learning agent's observation at the current tick (new arrays)."""
         loop, out = self.loop, {}
+        if loop is None:
+            raise RuntimeError("No game in progress: call reset() first.")
         time, pursuers = loop.time, loop.pursuers
         for agent, i, j, features in self._pursuer_agents:
             out[agent] = features.build(time, pursuers[i], loop.beliefs[j])
-        for agent, j, features in self._evader_agents:
+        for agent, j, evader_features in self._evader_agents:
             evader = loop.evaders[j]
-            out[agent] = features.build(evader, pursuers[nearest(pursuers, evader)])
+            out[agent] = evader_features.build(evader, pursuers[nearest(pursuers, evader)])
         return out
 
-    def info(self) -> dict:
+    def info(self) -> dict[str, object]:
         """The step's info (see the module docstring); a new dict each call."""
         loop = self.loop
-        info = {"time": loop.time, "tracking_rate": loop.metrics.tracking_rate}
+        if loop is None:
+            raise RuntimeError("No game in progress: call reset() first.")
+        info: dict[str, object] = {"time": loop.time, "tracking_rate": loop.metrics.tracking_rate}
         if loop.done:
             info["metrics"] = loop.metrics.summary()
         return info
 
     def _remember(self) -> None:
         loop = self.loop
+        if loop is None:
+            raise RuntimeError("No game in progress: call reset() first.")
         for _, i, j, features in self._pursuer_agents:
             features.remember(loop.time, loop.detections[i][j])
 

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import NamedTuple, overload
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 FREE = 0
 OCCUPIED = 100
@@ -96,7 +97,13 @@ class OccupancyGrid:
         """Bool (height, width): True where the cell is known free."""
         return ~self.blocked
 
-    def world_to_cell(self, x, y):
+    @overload
+    def world_to_cell(self, x: float, y: float) -> tuple[int, int]: ...
+    @overload
+    def world_to_cell(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+    def world_to_cell(
+        self, x: float | np.ndarray, y: float | np.ndarray
+    ) -> tuple[int, int] | tuple[np.ndarray, np.ndarray]:
         """Map-frame (x, y) in metres -> integer (row, col) of the containing cell.
 
         Works on scalars or arrays; results may lie outside the grid (see ``contains``).
@@ -109,18 +116,26 @@ class OccupancyGrid:
                 c, s = math.cos(yaw), math.sin(yaw)
                 dx, dy = c * dx + s * dy, -s * dx + c * dy
             return math.floor(dy / self.resolution), math.floor(dx / self.resolution)
-        dx = np.asarray(x, dtype=float) - ox
-        dy = np.asarray(y, dtype=float) - oy
+        ux = np.asarray(x, dtype=float) - ox
+        uy = np.asarray(y, dtype=float) - oy
         if yaw:
             c, s = math.cos(yaw), math.sin(yaw)
-            dx, dy = c * dx + s * dy, -s * dx + c * dy
-        col = np.floor(dx / self.resolution).astype(np.int64)
-        row = np.floor(dy / self.resolution).astype(np.int64)
+            ux, uy = c * ux + s * uy, -s * ux + c * uy
+        col = np.floor(ux / self.resolution).astype(np.int64)
+        row = np.floor(uy / self.resolution).astype(np.int64)
         if row.ndim == 0:
             return int(row), int(col)
         return row, col
 
-    def cell_to_world(self, row, col):
+    @overload
+    def cell_to_world(
+        self, row: int | np.integer, col: int | np.integer
+    ) -> tuple[float, float]: ...
+    @overload
+    def cell_to_world(self, row: np.ndarray, col: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+    def cell_to_world(
+        self, row: int | np.integer | np.ndarray, col: int | np.integer | np.ndarray
+    ) -> tuple[float, float] | tuple[np.ndarray, np.ndarray]:
         """Integer (row, col) -> map-frame (x, y) of the cell centre, metres."""
         ox, oy, yaw = self.origin
         u = (np.asarray(col, dtype=float) + 0.5) * self.resolution
@@ -133,7 +148,11 @@ class OccupancyGrid:
             return float(x), float(y)
         return x, y
 
-    def contains(self, row, col):
+    @overload
+    def contains(self, row: np.ndarray, col: np.ndarray) -> np.ndarray: ...
+    @overload
+    def contains(self, row: int | np.integer, col: int | np.integer) -> np.bool_: ...
+    def contains(self, row: ArrayLike, col: ArrayLike) -> np.ndarray | np.bool_:
         """True where (row, col) indexes a cell of the grid."""
         row, col = np.asarray(row), np.asarray(col)
         return (row >= 0) & (row < self.height) & (col >= 0) & (col < self.width)

@@ -15,10 +15,10 @@ Units and frames: map-frame (x, y) in metres (:mod:`pegame.grid`); grid arrays a
 
 from __future__ import annotations
 
-import functools
 import inspect
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -323,6 +323,7 @@ class Planner:
             return _unreachable("no traversable cell in the map")
         label = self._labels[start]
         exact_goal = self._is_traversable(goal_xy)
+        goal: tuple[int, int] | None
         if exact_goal:
             goal = self.grid.world_to_cell(goal_xy[0], goal_xy[1])
             if self._labels[goal] != label:
@@ -347,12 +348,20 @@ class Planner:
         return PathResult(path, length, True, "", float(cost), int(searched))
 
 
-@functools.cache
-def _parameters(cls: type, radius: float, options: tuple) -> tuple:
+#: (class, radius, options) -> :func:`_parameters`, filled as they are asked for
+_BOUND: dict[tuple[type, float, tuple[tuple[str, Any], ...]], tuple[Any, ...]] = {}
+
+
+def _parameters(cls: type, radius: float, options: tuple[tuple[str, Any], ...]) -> tuple[Any, ...]:
     """The constructor arguments of ``cls`` after the grid for ``radius`` and the (name,
     value) ``options``, the defaults filled in (so that omitted and explicit defaults
     share a planner); cached: binding a signature costs about 40 us, and every plugin
-    constructor asks for its planner."""
-    arguments = inspect.signature(cls).bind(None, radius, **dict(options))
-    arguments.apply_defaults()
-    return tuple(arguments.arguments.values())[1:]
+    constructor asks for its planner. (A dict, not functools.cache: mypy does not take a
+    class for the Hashable that the cache's arguments are typed as.)"""
+    key = (cls, radius, options)
+    bound = _BOUND.get(key)
+    if bound is None:
+        arguments = inspect.signature(cls).bind(None, radius, **dict(options))
+        arguments.apply_defaults()
+        bound = _BOUND[key] = tuple(arguments.arguments.values())[1:]
+    return bound

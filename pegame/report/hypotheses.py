@@ -49,10 +49,10 @@ def compare_cells(
     ``y``'s, Holm-corrected across the tested cells; ``holds`` is None when untested. Each
     row's ``paired`` is the Wilcoxon signed-rank test of x - y on the common seeds of
     ``seeded`` (none when ``seeded`` is None), Holm-corrected across its tested cells."""
-    rows = []
+    rows: list[dict[str, Any]] = []
     for map_name, ratio in cells:
         a, b = rates.get((map_name, ratio, x), []), rates.get((map_name, ratio, y), [])
-        row = {
+        row: dict[str, Any] = {
             "map": map_name,
             "speed_ratio": ratio,
             "x": x,
@@ -67,8 +67,12 @@ def compare_cells(
         if a and b:
             u, p = mann_whitney(a, b, alternative)
             row.update(U=u, p=p)
-        pair = [(seeded or {}).get((map_name, ratio, pairing), {}) for pairing in (x, y)]
-        row["paired"] = {**paired_test(*pair, alternative), "p_holm": None, "holds": None}
+        x_seeds, y_seeds = ((seeded or {}).get((map_name, ratio, p), {}) for p in (x, y))
+        row["paired"] = {
+            **paired_test(x_seeds, y_seeds, alternative),
+            "p_holm": None,
+            "holds": None,
+        }
         rows.append(row)
     tested = [row for row in rows if row["p"] is not None]
     for row, adjusted in zip(tested, holm([row["p"] for row in tested])):

@@ -16,7 +16,7 @@ import json
 import logging
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -158,7 +158,7 @@ def job_config(job: Path) -> dict[str, Any] | None:
     if not isinstance(config, dict):
         return None
     for *parents, leaf in NOT_CONFIG:
-        node = config
+        node: Any = config
         for parent in parents:
             node = node.get(parent) if isinstance(node, dict) else None
         if isinstance(node, dict):
@@ -213,24 +213,24 @@ def read_jsonl(path: Path, name: str) -> tuple[list[dict[str, Any]], list[dict[s
         if reason is not None:
             log.warning("skipping %s line %d: %s", name, number, reason)
             skipped.append({"file": name, "line": number, "reason": reason})
-        else:
+        elif record is not None:  # parse_line gives a record or a reason
             records.append({**record, "line": number})
     return records, skipped
 
 
-def load_sweep(roots: str | Path | list[str | Path]) -> Sweep:
+def load_sweep(roots: str | Path | Sequence[str | Path]) -> Sweep:
     """Read every job below the sweep directories ``roots`` (one path or several, in order:
     later directories' lines come after earlier ones')."""
-    roots = [Path(r) for r in ([roots] if isinstance(roots, (str, Path)) else roots)]
-    for root in roots:
+    paths = [Path(r) for r in ([roots] if isinstance(roots, (str, Path)) else roots)]
+    for root in paths:
         if not root.is_dir():
             raise ReportError(
                 f"No such sweep directory: {root}. Give the directory of a "
                 f"multirun (the one holding the numbered job directories)."
             )
     sweep = Sweep()
-    for root in roots:
-        prefix = "" if len(roots) == 1 else f"{root.as_posix()}/"
+    for root in paths:
+        prefix = "" if len(paths) == 1 else f"{root.as_posix()}/"
         for job in find_job_dirs(root):
             read_job(
                 sweep, job, prefix + relative(job, root), prefix + relative(job / RESULTS, root)
