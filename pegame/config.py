@@ -31,6 +31,11 @@ from pegame.types import Camera
 #: evader moves and then pursuer moves" (see :mod:`pegame.loop`)
 TURN_ORDERS = ("simultaneous", "evader_first")
 
+#: the most simulator steps one game may take (ticks x substeps): a bound on one game's
+#: time and memory, not on the model (a 90 s game at 10 Hz is 900; the bound is a day at
+#: 100 Hz, minutes of CPU and gigabytes of trajectory)
+MAX_STEPS = 8_640_000
+
 
 @dataclass
 class GameConfig:
@@ -60,6 +65,14 @@ class GameConfig:
             self.ticks >= 1,
             "game.t_max",
             f"at least one control tick, {1 / self.control_hz:g} s at game.control_hz={self.control_hz:g}",
+            self.t_max,
+        )
+        require(
+            self.ticks * self.substeps <= MAX_STEPS,
+            "game.t_max",
+            f"at most {MAX_STEPS} simulator steps per game (t_max * physics_hz, or * "
+            f"control_hz without physics_hz): {MAX_STEPS / (self.control_hz * self.substeps):g} s "
+            f"at these rates",
             self.t_max,
         )
         require(
@@ -245,11 +258,20 @@ def resolve_map_path(map_path: str, base_dir: str | Path | None = None) -> Path:
     return shipped if shipped.exists() else candidate
 
 
+def plain(node: DictConfig, resolve: bool = False) -> dict[str, Any]:
+    """A config node as plain containers (OmegaConf.to_container), interpolations
+    ``resolve``d or kept."""
+    container = OmegaConf.to_container(node, resolve=resolve)
+    if not isinstance(container, dict):
+        raise TypeError(f"Expected a mapping config node, got {type(container).__name__}.")
+    return {str(key): value for key, value in container.items()}
+
+
 def typed(node: Mapping[str, Any], schema: type, key: str) -> Any:
     """Build the dataclass ``schema`` from a config ``node`` found at ``key`` (e.g.
     ``game``), running its range checks. Unknown keys and wrong types raise ConfigError
     naming the full key and what is allowed."""
-    params = OmegaConf.to_container(node) if isinstance(node, DictConfig) else dict(node)
+    params = plain(node) if isinstance(node, DictConfig) else dict(node)
     allowed = [f.name for f in fields(schema)]
     unknown = sorted(set(params) - set(allowed))
     if unknown:
@@ -259,11 +281,28 @@ def typed(node: Mapping[str, Any], schema: type, key: str) -> Any:
             f"Allowed keys under '{key}': {', '.join(allowed)}."
         )
     try:
-        return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(schema), params))
+        merged = OmegaConf.merge(OmegaConf.structured(schema), params)
+        check_finite(merged, schema, key)
+        return OmegaConf.to_object(merged)
     except OmegaConfBaseException as exc:
         where = f"{key}.{exc.full_key}" if getattr(exc, "full_key", None) else key
         reason = str(exc).splitlines()[0]
         raise ConfigError(f"Invalid value for '{where}': {reason}.") from None
+
+
+def check_finite(node: DictConfig, schema: type, key: str) -> None:
+    """ConfigError for a NaN, and for an infinite value of a field whose default is
+    finite: infinity is a setting only where the default is one (``a_max: .inf``, no
+    limit); elsewhere it would overflow or never end. Checked before the dataclass's own
+    range checks, which may compute with the value."""
+    for item in fields(schema):
+        value = node.get(item.name)
+        if not isinstance(value, float) or math.isfinite(value):
+            continue
+        default = item.default
+        infinite_default = isinstance(default, float) and math.isinf(default)
+        allowed = "a number or .inf" if infinite_default else "a finite number"
+        require(infinite_default and not math.isnan(value), f"{key}.{item.name}", allowed, value)
 
 
 def compose(overrides: Sequence[str] = ()) -> DictConfig:

@@ -14,11 +14,11 @@ imported, when Hydra loads its file.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import fields
 from importlib.metadata import entry_points
 from importlib.resources import files
-from importlib.resources.abc import Traversable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from hydra._internal.core_plugins.importlib_resources_config_source import (
     ImportlibResourcesConfigSource,
@@ -30,6 +30,12 @@ from omegaconf import DictConfig, OmegaConf
 
 from pegame import registry
 from pegame.api import PLUGIN_KINDS
+
+if TYPE_CHECKING:  # pragma: no cover - typing only; importlib.resources.abc is 3.11+
+    if sys.version_info >= (3, 11):
+        from importlib.resources.abc import Traversable
+    else:
+        from importlib.abc import Traversable
 
 #: the scheme of :class:`PluginOptionSource` on Hydra's search path
 SCHEME = "pegame"
@@ -72,7 +78,7 @@ def option_kind(config_path: str) -> str | None:
     return group if slash and "/" not in name and group in PLUGIN_KINDS else None
 
 
-class PluginOptionSource(ImportlibResourcesConfigSource):  # type: ignore[misc]
+class PluginOptionSource(ImportlibResourcesConfigSource):
     """Hydra's ``pkg://`` source for a config package, with each plugin option file
     merged over its plugin's ``Config`` defaults (module docstring). Other files, and an
     option file without ``name:`` (Hydra's own error then), load as they are."""
@@ -91,7 +97,7 @@ class PluginOptionSource(ImportlibResourcesConfigSource):  # type: ignore[misc]
         return result
 
 
-class PluginSearchPath(SearchPathPlugin):  # type: ignore[misc]
+class PluginSearchPath(SearchPathPlugin):
     """Puts every config package on Hydra's search path through
     :class:`PluginOptionSource`: pegame's first (ahead of its plain ``pkg://`` entry, so
     that its option files get their defaults), the plugin distributions' last, so

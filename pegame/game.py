@@ -45,7 +45,15 @@ from pegame.api import (
     Simulator,
     Tick,
 )
-from pegame.config import EnvConfig, GameConfig, TeamConfig, resolve_map_path, team_members, typed
+from pegame.config import (
+    EnvConfig,
+    GameConfig,
+    TeamConfig,
+    plain,
+    resolve_map_path,
+    team_members,
+    typed,
+)
 from pegame.errors import ConfigError, SpawnError
 from pegame.files import write_atomic
 from pegame.grid import OccupancyGrid, load_map, per_grid, read_only
@@ -274,15 +282,6 @@ def check_room_for_team(context: Context, pursuers: int, evaders: int) -> None:
             f"{evaders} evader(s): it has room for {room} bodies of radius {radius} m apart. "
             "Use a smaller team (team.pursuers, team.evaders), a larger map or smaller radii."
         )
-
-
-def plain(node: DictConfig, resolve: bool = False) -> dict[str, Any]:
-    """A config node as plain containers (OmegaConf.to_container), interpolations
-    ``resolve``d or kept."""
-    container = OmegaConf.to_container(node, resolve=resolve)
-    if not isinstance(container, dict):
-        raise TypeError(f"Expected a mapping config node, got {type(container).__name__}.")
-    return {str(key): value for key, value in container.items()}
 
 
 class Scenario:

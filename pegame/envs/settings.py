@@ -10,7 +10,7 @@ from dataclasses import dataclass, fields
 
 from omegaconf import DictConfig, OmegaConf
 
-from pegame.config import compose
+from pegame.config import compose, plain
 from pegame.envs.observations import ObservationSettings
 from pegame.errors import ConfigError, require
 
@@ -86,7 +86,7 @@ def env_config(
     if overrides:
         raise ConfigError("Pass either config (a composed DictConfig) or overrides, not both.")
     source = config if isinstance(config, DictConfig) else OmegaConf.create(config)
-    cfg = OmegaConf.create(OmegaConf.to_container(source, resolve=True))
+    cfg = OmegaConf.create(plain(source, resolve=True))
     for role, name in opponents.items():
         if cfg[role].name != name:
             raise ConfigError(
