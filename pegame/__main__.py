@@ -7,17 +7,24 @@ or plugin name is reported as one paragraph with exit status 2 and no traceback 
 HYDRA_FULL_ERROR=1 for one); in a multirun the bad job writes an ``invalid`` line and
 the other jobs run. Exit status (:mod:`pegame.sweep`): 0 every game of every job
 finished, 1 some games failed (recorded), 2 bad input; 130 after Ctrl-C or SIGTERM.
+
+A job writes to its directory only once it owns it (:func:`pegame.job.run_job` calls
+``adopt``): Hydra's files (``.hydra/``, which Hydra is told not to write,
+``hydra.output_subdir: null``) and the job's log (``pegame.log``; its records until then
+are held in memory) are written then, so a refused run leaves the directory as it was.
 """
 
 from __future__ import annotations
 
 import logging
+import logging.handlers
 import os
 import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
 from importlib.resources import files
+from pathlib import Path
 
 import hydra
 from hydra.core.hydra_config import HydraConfig
@@ -31,6 +38,7 @@ from pegame import sweep
 from pegame.api import PLUGIN_KINDS
 from pegame.config import did_you_mean, register_schema
 from pegame.errors import JobDirectoryError, PegameError, PluginChoiceError
+from pegame.files import make_dir, write_atomic
 
 log = logging.getLogger("pegame")
 
@@ -55,22 +63,94 @@ def report_error(exc: PegameError) -> None:
     log.error("%s", exc)
 
 
+class HeldLog:
+    """The job's log file held back: its handlers (Hydra's file handler, opened lazily,
+    ``delay: true``) are detached from the root logger and the records kept in memory
+    until :meth:`write` attaches them, with the records so far, or :meth:`drop` discards
+    them (a refused run writes no log into another job's directory)."""
+
+    def __init__(self, out_dir: str) -> None:
+        root = logging.getLogger()
+        inside = Path(out_dir).resolve()
+        self.handlers = [
+            h
+            for h in root.handlers
+            if isinstance(h, logging.FileHandler) and Path(h.baseFilename).parent == inside
+        ]
+        self.memory = logging.handlers.MemoryHandler(capacity=1 << 30, flushLevel=1 << 30)
+        for handler in self.handlers:
+            root.removeHandler(handler)
+        root.addHandler(self.memory)
+
+    def write(self) -> None:
+        """Attach the log's handlers and write the records held so far."""
+        root = logging.getLogger()
+        root.removeHandler(self.memory)
+        for handler in self.handlers:
+            for record in self.memory.buffer:
+                if record.levelno >= handler.level:
+                    handler.handle(record)
+            root.addHandler(handler)
+        self.memory.buffer.clear()
+        self.handlers = []
+
+    def drop(self) -> None:
+        """Discard the records and close the log's handlers unopened."""
+        logging.getLogger().removeHandler(self.memory)
+        self.memory.buffer.clear()
+        for handler in self.handlers:
+            handler.close()
+        self.handlers = []
+
+
+def adopter(cfg: DictConfig, out_dir: str, held: HeldLog) -> Callable[[], None]:
+    """What a job writes once it owns ``out_dir``: Hydra's files of the job in ``.hydra/``
+    (the composed ``cfg``, Hydra's config and the overrides, as Hydra writes them) and the
+    log held so far."""
+    hydra_cfg = HydraConfig.instance().cfg
+    texts = {
+        "config.yaml": OmegaConf.to_yaml(cfg),
+        "hydra.yaml": OmegaConf.to_yaml(hydra_cfg),
+        "overrides.yaml": OmegaConf.to_yaml(hydra_cfg.hydra.overrides.task),
+    }
+
+    def adopt() -> None:
+        folder = make_dir(Path(out_dir) / ".hydra")
+        for name, text in texts.items():
+            write_atomic(folder / name, text)
+        held.write()
+
+    return adopt
+
+
 @hydra.main(version_base=None, config_path="pkg://pegame.conf", config_name="config")
 def _app(cfg: DictConfig) -> int:
     from pegame.job import run_job, write_invalid
 
     hydra_cfg = HydraConfig.get()
     out_dir, overrides = hydra_cfg.runtime.output_dir, list(hydra_cfg.overrides.task)
+    held = HeldLog(out_dir)
+    adopt = adopter(cfg, out_dir, held)
     try:
         sweep_defaults(cfg)
-        status = run_job(cfg, out_dir, base_dir=get_original_cwd(), overrides=overrides).status
+        status = run_job(
+            cfg, out_dir, base_dir=get_original_cwd(), overrides=overrides, adopt=adopt
+        ).status
     except PegameError as exc:
         if os.environ.get("HYDRA_FULL_ERROR") == "1":
             raise
+        mine = hydra_cfg.mode == RunMode.MULTIRUN and not isinstance(exc, JobDirectoryError)
+        if mine:  # an invalid cell of this sweep: its log and its line say why
+            held.write()
         report_error(exc)
-        if hydra_cfg.mode == RunMode.MULTIRUN and not isinstance(exc, JobDirectoryError):
-            write_invalid(out_dir, exc, overrides)  # another job's directory stays its own
+        if mine:
+            try:
+                write_invalid(out_dir, exc, overrides)
+            except PegameError as unwritten:
+                report_error(unwritten)
         status = sweep.BAD_INPUT
+    finally:
+        held.drop()  # a refused run's records were shown on the console only
     sweep.job_ended(status)
     return status
 

@@ -1,17 +1,37 @@
-"""Hydra callbacks of a multirun, run in the sweep's process: collect the jobs' exit
-statuses and write the sweep report."""
+"""Hydra callbacks, run in the process that Hydra starts in: check the output directory
+before Hydra writes to it, collect a multirun's exit statuses and write the sweep report."""
 
 from __future__ import annotations
 
 import logging
-from typing import Any
+import sys
+from typing import Any, NoReturn
 
 from hydra.experimental.callback import Callback
 from omegaconf import DictConfig
 
 from pegame import sweep
+from pegame.errors import PegameError
+from pegame.files import make_dir
 
 log = logging.getLogger("pegame")
+
+
+def refuse(exc: PegameError) -> NoReturn:
+    """Stop the run before Hydra writes a file: one message, exit status 2."""
+    print(f"pegame: error: {exc}", file=sys.stderr)
+    raise SystemExit(sweep.BAD_INPUT)  # passes through Hydra, which catches Exception only
+
+
+class OutputDirCallback(Callback):
+    """A single run's directory must be one pegame can write to (not a file, not on a
+    read-only file system): checked, and created, before Hydra writes its log there."""
+
+    def on_run_start(self, config: DictConfig, **kwargs: Any) -> None:
+        try:
+            make_dir(config.hydra.run.dir)
+        except PegameError as exc:
+            refuse(exc)
 
 
 class ExitStatusCallback(Callback):
@@ -19,7 +39,10 @@ class ExitStatusCallback(Callback):
     end, so ``python -m pegame -m ...`` exits with the worst (see :mod:`pegame.sweep`)."""
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
-        sweep.start_sweep(config.hydra.sweep.dir)
+        try:
+            sweep.start_sweep(config.hydra.sweep.dir, resume=bool(config.get("resume", False)))
+        except PegameError as exc:  # another sweep's directory, or one pegame cannot write
+            refuse(exc)
 
     def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
         status = sweep.end_sweep()

@@ -32,8 +32,8 @@ from pegame.types import Camera
 TURN_ORDERS = ("simultaneous", "evader_first")
 
 #: the most simulator steps one game may take (ticks x substeps): a bound on one game's
-#: time and memory, not on the model (a 90 s game at 10 Hz is 900; the bound is a day at
-#: 100 Hz, minutes of CPU and gigabytes of trajectory)
+#: time and memory (its trajectory has a row per tick), not on the model: a day of game
+#: time at 100 Hz (a 90 s game at 10 Hz is 900)
 MAX_STEPS = 8_640_000
 
 

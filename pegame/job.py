@@ -14,7 +14,9 @@ config, the map, every plugin and its options): a bad value is a
 :class:`~pegame.errors.PegameError` and nothing is played. The job holds the directory's
 lock (:mod:`pegame.joblock`) while it runs. With ``resume=true`` a game is skipped when a
 game with the same config hash and seed is stored; a directory holding games of another
-config is an error naming the keys that differ. A job of one game also writes
+config is an error naming the keys that differ. Only a job that passed those checks
+writes to the directory: ``adopt`` (Hydra's files of the job, its log) is called then, so
+a refused job leaves the directory as it was. A job of one game also writes
 ``result.json`` (last, atomically), ``trajectory.csv`` and ``trajectory.png``;
 recordings are ``game.rrd``, or ``game_<seed>.rrd`` when the job plays several games.
 """
@@ -27,17 +29,16 @@ import os
 import sys
 import time
 import traceback
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from omegaconf import DictConfig
 
-from pegame import sweep
+from pegame import files, sweep
 from pegame.config import check_known_keys
 from pegame.errors import JobDirectoryError, PegameError, ResultsWriteError, SpawnError
-from pegame.files import write_atomic
 from pegame.game import Game, Outcome, Scenario, pairing, summary_line, write_outcome
 from pegame.joblock import JobLock
 from pegame.kernel_cache import announce_compilation
@@ -63,14 +64,17 @@ class JobRun:
 
 
 def read_lines(path: Path) -> Iterator[dict[str, Any]]:
-    """The entries of a results.jsonl; lines truncated by a killed job are skipped (and
-    anything but a regular file holds none)."""
+    """The entries (JSON objects) of a results.jsonl; lines truncated by a killed job,
+    lines that are no JSON object and bytes that are no UTF-8 are skipped (and anything but
+    a regular file holds none)."""
     if path.is_file():
-        for line in path.read_text().splitlines():
+        for line in path.read_bytes().decode("utf-8", errors="replace").splitlines():
             try:
-                yield json.loads(line)
-            except json.JSONDecodeError:
+                entry = json.loads(line)
+            except (json.JSONDecodeError, RecursionError):
                 continue
+            if isinstance(entry, dict):
+                yield entry
 
 
 def stored_seeds(path: Path, config: dict[str, Any]) -> set[int]:
@@ -95,8 +99,9 @@ def stored_seeds(path: Path, config: dict[str, Any]) -> set[int]:
                 f"choose another output directory (hydra.run.dir or hydra.sweep.dir) or move "
                 f"the old results away."
             )
-        if entry["kind"] == "game":
-            seeds.add(int(entry["seed"]))
+        seed = entry.get("seed")
+        if entry["kind"] == "game" and isinstance(seed, int) and not isinstance(seed, bool):
+            seeds.add(seed)
     return seeds
 
 
@@ -108,24 +113,14 @@ def append_line(path: Path, entry: dict[str, Any]) -> None:
     is printed in full on stderr first, so a finished game's result can be recovered."""
     line = json.dumps(entry).encode() + b"\n"
     try:
-        with path.open("ab+") as handle:
-            if handle.seek(0, os.SEEK_END) > 0:
-                handle.seek(-1, os.SEEK_END)
-                if handle.read(1) != b"\n":
-                    handle.write(b"\n")
-            handle.write(line)
-            handle.flush()
-    except OSError as exc:
+        files.append_line(path, line)
+    except ResultsWriteError as exc:
         print(
             f"pegame: this line could not be written to {path}:\n{line.decode()}",
             file=sys.stderr,
             end="",
         )
-        raise ResultsWriteError(
-            f"Could not write to {path}: {exc.strerror or exc}. The unwritten line is printed "
-            f"above on stderr; free space or choose another output directory, then run again "
-            f"with resume=true."
-        ) from None
+        raise ResultsWriteError(f"{exc} The unwritten line is printed above on stderr.") from None
 
 
 def progress(seeds: list[int]) -> Iterator[int]:
@@ -142,17 +137,24 @@ def run_job(
     out_dir: str | Path,
     base_dir: str | Path | None = None,
     overrides: Sequence[str] = (),
+    adopt: Callable[[], None] | None = None,
 ) -> JobRun:
     """Play the job's games into ``out_dir``, holding its lock; ``overrides`` are the
-    command-line overrides recorded with every game. PegameError before the first game
-    for a config that cannot be played at all."""
+    command-line overrides recorded with every game; ``adopt`` is called once every check
+    passed, before the first game (the app writes Hydra's files and the log then).
+    PegameError before the first game for a config that cannot be played at all, or a
+    directory that belongs to another job; nothing is written to the directory then."""
     out_dir = Path(out_dir)
     with JobLock(out_dir):
-        return _run_locked(cfg, out_dir, base_dir, list(overrides))
+        return _run_locked(cfg, out_dir, base_dir, list(overrides), adopt)
 
 
 def _run_locked(
-    cfg: DictConfig, out_dir: Path, base_dir: str | Path | None, overrides: list[str]
+    cfg: DictConfig,
+    out_dir: Path,
+    base_dir: str | Path | None,
+    overrides: list[str],
+    adopt: Callable[[], None] | None,
 ) -> JobRun:
     scenario = checked_scenario(cfg, base_dir)
     settings = scenario.settings
@@ -161,6 +163,9 @@ def _run_locked(
     stored = stored_seeds(results_path, config)
     done = stored if cfg.get("resume", False) else set()
     seeds = [s for s in range(settings.seed, settings.seed + settings.trials) if s not in done]
+    prepared = built_game(scenario, seeds[0] if seeds else settings.seed)
+    if adopt is not None:
+        adopt()
     if done:
         log.info(
             "resume: %d of %d games already stored", settings.trials - len(seeds), settings.trials
@@ -177,9 +182,12 @@ def _run_locked(
             stop_orphaned(len(run.played))
         started = time.perf_counter()
         try:
-            game = scenario.game(seed)
+            game = (
+                prepared if prepared is not None and prepared.seed == seed else scenario.game(seed)
+            )
+            prepared = None
             outcome = game.play(out_dir, "game" if single else f"game_{seed}")
-        except Exception as exc:
+        except (Exception, SystemExit) as exc:  # a plugin's sys.exit fails its game only
             run.failed.append(seed)
             record_failure(out_dir, seed, cfg, exc, identity)
             continue
@@ -189,6 +197,8 @@ def _run_locked(
         if single:
             write_single(outcome, game, out_dir)
         print(summary_line(outcome.result))
+    if prepared is not None:
+        prepared.plugins.sim.close()
     rates = [r["tracking_rate"] for r in run.played]
     append_line(
         results_path,
@@ -212,6 +222,19 @@ def checked_scenario(cfg: DictConfig, base_dir: str | Path | None) -> Scenario:
     scenario = Scenario(cfg, base_dir)
     check_room_to_spawn(scenario)
     return scenario
+
+
+def built_game(scenario: Scenario, seed: int) -> Game | None:
+    """The game of ``seed``, built before the first game is played: building it builds
+    every plugin, which loads what the plugins read (a policy file or module), so a bad
+    path is a PegameError here, not a failure of every game. Any other error (a plugin
+    failing for this seed, even with SystemExit) is left to the game: None."""
+    try:
+        return scenario.game(seed)
+    except PegameError:
+        raise
+    except (Exception, SystemExit):
+        return None
 
 
 def check_room_to_spawn(scenario: Scenario) -> None:
@@ -246,7 +269,7 @@ def stop_orphaned(stored: int) -> None:
 def write_invalid(out_dir: str | Path, error: PegameError, overrides: Sequence[str]) -> None:
     """Record a multirun job whose config cannot be played: one ``invalid`` line, so the
     sweep report shows the cell as failed and the other cells still run."""
-    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    files.make_dir(out_dir)
     append_line(
         Path(out_dir) / RESULTS,
         {
@@ -272,8 +295,7 @@ def write_single(outcome: Outcome, game: Game, out_dir: Path) -> None:
         write_outcome(outcome, out_dir)
     except OSError as exc:
         raise ResultsWriteError(
-            f"Could not write the game's files in {out_dir}: {exc}. Its result is stored in "
-            f"{out_dir / RESULTS}."
+            f"{exc} The game's result is stored in {out_dir / RESULTS}."
         ) from None
 
 
@@ -283,7 +305,7 @@ def record_failure(
     """Log a failed game, keep its traceback, and append a 'failed' line naming the seed
     and the cause."""
     text = "".join(traceback.format_exception(exc))
-    write_atomic(out_dir / f"failed_{seed}.txt", text)
+    files.write_atomic(out_dir / f"failed_{seed}.txt", text)
     log.error("seed %d failed: %s (traceback in failed_%d.txt)", seed, exc, seed)
     append_line(
         out_dir / RESULTS,

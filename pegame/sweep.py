@@ -8,6 +8,13 @@ creates a status directory in the sweep dir when the multirun starts
 (:func:`start_sweep`), each job writes its status there (:func:`job_ended`), and the
 sweep's process reads them when the multirun ends (:func:`end_sweep`).
 
+One owner per sweep directory: :func:`start_sweep` takes an exclusive ``flock`` on
+``<sweep dir>/.pegame-sweep``, which records the owner (PID, start time, command line),
+before Hydra writes anything there, and holds it until :func:`end_sweep`. A second sweep
+into the directory is refused (:class:`SweepOwnedError`, naming the first) without
+touching a file: while the first runs, and after it ended unless it is a resume
+(``resume=true``), which becomes the owner.
+
 Orphaned workers: a worker process whose parent (the sweep's process) was killed
 (``kill -9``) is re-parented and would go on appending games, racing a later resume.
 :func:`sweep_parent` tells a job that it runs in such a worker; the job checks
@@ -16,11 +23,19 @@ Orphaned workers: a worker process whose parent (the sweep's process) was killed
 
 from __future__ import annotations
 
+import fcntl
+import json
 import os
+import shlex
 import shutil
+import sys
 import tempfile
+import time
 import uuid
 from pathlib import Path
+
+from pegame.errors import JobDirectoryError
+from pegame.files import make_dir, write_failed
 
 OK, GAMES_FAILED, BAD_INPUT = 0, 1, 2
 
@@ -28,7 +43,15 @@ OK, GAMES_FAILED, BAD_INPUT = 0, 1, 2
 STATUS_DIR_ENV = "PEGAME_STATUS_DIR"
 SWEEP_PID_ENV = "PEGAME_SWEEP_PID"
 
+#: the file of a sweep directory that names its owner and carries its flock
+OWNER_FILE = ".pegame-sweep"
+
 _worst = OK
+_owner_fd: int | None = None
+
+
+class SweepOwnedError(JobDirectoryError):
+    """The sweep directory belongs to another sweep (running, or ended and not resumed)."""
 
 
 def record(status: int) -> None:
@@ -50,17 +73,79 @@ def job_ended(status: int) -> None:
         (Path(directory) / f"{os.getpid()}-{uuid.uuid4().hex}").write_text(f"{status}\n")
 
 
-def start_sweep(sweep_dir: str | Path) -> None:
-    """In the sweep's process, before any job: create the status directory and tell the
-    jobs (through the environment their processes inherit) where it is and who we are."""
-    Path(sweep_dir).mkdir(parents=True, exist_ok=True)
-    os.environ[STATUS_DIR_ENV] = tempfile.mkdtemp(prefix=".pegame-status-", dir=sweep_dir)
+def start_sweep(sweep_dir: str | Path, resume: bool = False) -> None:
+    """In the sweep's process, before any job: become the sweep directory's owner
+    (SweepOwnedError when another sweep owns it, see the module docstring), create the
+    status directory and tell the jobs (through the environment their processes inherit)
+    where it is and who we are."""
+    global _owner_fd
+    sweep_dir = Path(sweep_dir)
+    _owner_fd = take_ownership(sweep_dir, resume)
+    try:
+        status_dir = tempfile.mkdtemp(prefix=".pegame-status-", dir=sweep_dir)
+    except OSError as exc:
+        raise write_failed(sweep_dir, exc) from None
+    os.environ[STATUS_DIR_ENV] = status_dir
     os.environ[SWEEP_PID_ENV] = str(os.getpid())
+
+
+def take_ownership(sweep_dir: Path, resume: bool) -> int:
+    """The descriptor of ``sweep_dir``'s owner file, flocked and naming this sweep.
+    SweepOwnedError, with nothing written, when another sweep owns the directory."""
+    path = sweep_dir / OWNER_FILE
+    make_dir(sweep_dir)
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o644)
+    except FileExistsError:
+        fd = os.open(path, os.O_RDWR)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise SweepOwnedError(
+                f"Another sweep is running in {sweep_dir}: {describe_owner(path)}. A sweep "
+                f"directory has one sweep: wait for it to end or stop it, or choose another "
+                f"hydra.sweep.dir."
+            ) from None
+        if not resume:
+            os.close(fd)
+            raise SweepOwnedError(
+                f"{sweep_dir} holds another sweep: {describe_owner(path)}. A sweep directory "
+                f"has one sweep: run it again with resume=true to complete it, or choose "
+                f"another hydra.sweep.dir."
+            ) from None
+    except OSError as exc:
+        raise write_failed(path, exc) from None
+    else:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # created here: no one else holds it
+    owner = {"pid": os.getpid(), "started": time.strftime("%Y-%m-%d %H:%M:%S")}
+    owner["command"] = shlex.join(["pegame", *sys.argv[1:]])
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, (json.dumps(owner) + "\n").encode(), 0)
+    except OSError as exc:
+        os.close(fd)
+        raise write_failed(path, exc) from None
+    os.set_inheritable(fd, False)
+    return fd
+
+
+def describe_owner(path: Path) -> str:
+    """Who owns a sweep directory, from its owner file: 'PID p, started t: command'."""
+    try:
+        owner = json.loads(path.read_text())
+        return f"PID {owner['pid']}, started {owner['started']}: {owner['command']}"
+    except (OSError, ValueError, KeyError, TypeError):
+        return "an unknown sweep (its owner file is unreadable)"
 
 
 def end_sweep() -> int:
     """In the sweep's process, after every job: record and return the worst job status,
-    and remove the status directory."""
+    remove the status directory and release the sweep directory (its owner file stays)."""
+    global _owner_fd
+    if _owner_fd is not None:
+        os.close(_owner_fd)  # closing the descriptor releases the flock
+        _owner_fd = None
     directory = os.environ.pop(STATUS_DIR_ENV, None)
     os.environ.pop(SWEEP_PID_ENV, None)
     statuses = [OK]

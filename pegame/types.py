@@ -139,6 +139,11 @@ class Body:
     alpha_max: float = math.inf
 
 
+#: the most rays, and samples along a ray, of the visibility region (Algorithm 1): the
+#: default camera casts 655 rays of 100 samples; 10**5 samples at 0.05 m reach 5 km
+MAX_RAY_STEPS = 100_000
+
+
 @value_type
 class Camera:
     """The pursuer's forward-facing camera, a pinhole looking along the robot's heading.
@@ -165,6 +170,18 @@ class Camera:
         for key in ("image_width", "image_height", "angle_step", "distance_step"):
             value = getattr(self, key)
             require(value > 0, f"camera.{key}", "a positive number", value)
+        # Algorithm 1 casts fov / angle_step rays of far / distance_step samples each.
+        for count, key, value in (
+            (self.fov / self.angle_step, "camera.angle_step", self.angle_step),
+            (self.far / self.distance_step, "camera.far", self.far),
+        ):
+            require(
+                count <= MAX_RAY_STEPS,
+                key,
+                f"at most {MAX_RAY_STEPS} rays per view (camera.fov / camera.angle_step) and "
+                f"samples per ray (camera.far / camera.distance_step)",
+                value,
+            )
 
     @property
     def focal_px(self) -> float:

@@ -19,6 +19,7 @@ from omegaconf import DictConfig
 
 from pegame.envs.core import EnvGame, check_seed, game_seed
 from pegame.envs.settings import env_config, env_settings
+from pegame.errors import ConfigError
 
 PURSUIT_ID = "pegame/Pursuit-v0"
 EVASION_ID = "pegame/Evasion-v0"
@@ -36,6 +37,7 @@ class _SingleAgentEnv(gymnasium.Env):
     """
 
     role: ClassVar[str]
+    env_id: ClassVar[str]
     metadata = {"render_modes": []}
 
     def __init__(
@@ -49,6 +51,13 @@ class _SingleAgentEnv(gymnasium.Env):
         other = "evader" if self.role == "pursuer" else "pursuer"
         cfg = env_config(config, overrides, {other: opponent} if opponent is not None else None)
         self.game = EnvGame(cfg, self.settings, (self.role,))
+        for key, size in zip(("team.pursuers", "team.evaders"), self.game.scenario.team_size):
+            if size != 1:
+                raise ConfigError(
+                    f"Invalid value for '{key}' in {self.env_id}: {size}. Allowed: 1 (the "
+                    "single-agent envs play one pursuer against one evader; a team game is "
+                    "the PettingZoo env's, pegame.envs.parallel)."
+                )
         self.opponent = str(cfg[other].name)
         features = self.game.features[self.role]
         self.layout = features.layout
@@ -76,12 +85,14 @@ class PursuitEnv(_SingleAgentEnv):
     """``pegame/Pursuit-v0``: the learner is the pursuer."""
 
     role = "pursuer"
+    env_id = PURSUIT_ID
 
 
 class EvasionEnv(_SingleAgentEnv):
     """``pegame/Evasion-v0``: the learner is the evader."""
 
     role = "evader"
+    env_id = EVASION_ID
 
 
 def register_envs() -> None:

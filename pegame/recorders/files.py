@@ -1,22 +1,23 @@
 """Recording file names, and the status each name tells.
 
-A recording is written under a temporary name and renamed when its game ends, so that a
-name never claims more than the file holds:
+A recording is held in memory while its game runs and written when the game ends, under a
+temporary name renamed once the file is complete, so that a name never claims more than
+the file holds:
 
 =========================== ========== =====================================================
-``<game_id>.rrd.partial``   partial    being written: the game is running, or its process
-                                       was killed (or the recorder failed) before it ended
+``<game_id>.rrd.partial``   partial    being written (the game has ended), or its process
+                                       was killed while writing it
 ``<game_id>.rrd``           complete   the game finished; renamed from the partial file
-                                       once the file was closed (``rerun rrd verify`` passes)
-``<game_id>.failed.rrd``    failed     the game raised; closed and renamed at the failure,
-                                       readable up to the tick that failed
+                                       once every byte was written and synced
+                                       (``rerun rrd verify`` passes)
+``<game_id>.failed.rrd``    failed     the game raised; written at the failure, readable
+                                       up to the tick that failed
 =========================== ========== =====================================================
 
-The renames are ``os.replace`` in the same directory, atomic on POSIX file systems, done
-after the file is closed: a complete name survives a killed process. The file is not
-fsynced first (as :func:`pegame.files.write_atomic` does for results): a recording of
-megabytes would add to every recorded game's time on a slow disk, and a power cut is not what
-the names guard against. A later game of the same id replaces the file of its status; a
+The writes are :func:`pegame.files.write_atomic` (the partial file, fsynced, its size
+checked, then ``os.replace`` in the same directory, atomic on POSIX): a complete name
+survives a killed process, and a write that fails (a full disk) removes the partial file
+and fails the game. A later game of the same id replaces the file of its status; a
 finished game also removes its failed file. This module imports nothing heavy:
 :mod:`pegame.replay` lists recordings without rerun-sdk.
 """

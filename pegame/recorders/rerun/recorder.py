@@ -1,25 +1,34 @@
 """The Rerun recorder's life: start, log, finish or abort, and the sends in between.
 
 :class:`RerunRecorder` writes one recording per game through its own
-``rerun.RecordingStream`` (never the global stream), to ``<game_id>.rrd.partial`` while
-the game runs; :meth:`~RerunRecorder.finish` closes it and renames it to
-``<game_id>.rrd``, :meth:`~RerunRecorder.abort` (a game that raised) sends what it holds,
-an ERROR event and the error, closes it and renames it to ``<game_id>.failed.rrd``
-(see :mod:`pegame.recorders.files`). A killed game leaves the partial file.
+``rerun.RecordingStream`` (never the global stream) into memory (a ``rerun.BinaryStream``,
+plus a live viewer with ``spawn=true``) while the game runs; :meth:`~RerunRecorder.finish`
+closes it and writes its bytes to ``<game_id>.rrd.partial``, renamed to ``<game_id>.rrd``
+once written, synced and of the right size (:func:`pegame.files.write_atomic`);
+:meth:`~RerunRecorder.abort` (a game that raised) sends what it holds, an ERROR event and
+the error, and writes ``<game_id>.failed.rrd`` the same way (see
+:mod:`pegame.recorders.files`). A game killed before its end leaves no recording.
+
+Why pegame writes the file, not rerun-sdk's ``FileSink``: on a full disk the file sink
+logged "No space left on device", raised nothing, and its file was renamed as complete
+without its footer; with a little more room the game's thread waited forever on the
+recording stream. pegame's own write raises, so a recording that cannot be written is
+the game's failure (recorded, exit status 1), named in the job's log, and no broken file
+is left. The cost: a game's recording is held in memory until the game ends (a 25 s
+game on brick, about 0.9 MB).
 
 Cost. On the grid simulator a control tick takes about 0.3 ms, less than a few
 ``rr.log`` calls. So a tick's numbers are buffered as one row and its other data in
 per-entity buffers (:mod:`.columns`), all sent with ``send_columns`` every
 ``flush_every`` ticks (once per 90 s game by default: every send has a fixed cost of a
 few tenths of a millisecond per entity; ``live_flush_every`` when a viewer is spawned).
-A failure to write (unwritable directory, full disk) or any other error while recording
-disables the recorder with one warning, and leaves the partial file; the game goes on.
+Any other error while recording (a bad value to log) disables the recorder with one
+warning and leaves no file; the game goes on.
 """
 
 from __future__ import annotations
 
 import logging
-import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,7 +38,8 @@ import numpy as np
 import rerun as rr
 
 from pegame.api import Recorder, Tick
-from pegame.errors import require
+from pegame.errors import ResultsWriteError, require
+from pegame.files import make_dir, write_atomic
 from pegame.recorders.files import COMPLETE, FAILED, PARTIAL, recording_path
 from pegame.recorders.rerun.blueprint import blueprint
 from pegame.recorders.rerun.columns import ParticleRows, row_columns, tick_row, time_index
@@ -57,6 +67,9 @@ from pegame.recorders.rerun.team import buffer_team
 log = logging.getLogger(__name__)
 
 APPLICATION_ID = "pegame"
+
+#: seconds rerun-sdk may take to deliver a closed recording's last bytes
+FLUSH_TIMEOUT = 60.0
 
 
 class RerunRecorder(Recorder):
@@ -109,6 +122,7 @@ class RerunRecorder(Recorder):
         self.path: Path | None = None  # the recording's file: partial, then complete or failed
         self._game: tuple[Path, str] | None = None  # (out_dir, game_id)
         self._rec: rr.RecordingStream | None = None
+        self._stream: rr.BinaryStream | None = None  # the recording's bytes until written
         self._flush_every = config.live_flush_every if config.spawn else config.flush_every
         self._rows: list[tuple] = []  # columns.tick_row of each tick since the last send
         self._particles = ParticleRows(self._flush_every, config.max_particles, Z_PARTICLES)
@@ -141,18 +155,21 @@ class RerunRecorder(Recorder):
             self._fail("logging", exc)
 
     def finish(self, result: dict[str, Any]) -> None:
-        """Send what is buffered and the result, close the file and rename it to
-        ``<game_id>.rrd``."""
+        """Send what is buffered and the result, close the recording and write it to
+        ``<game_id>.rrd``. ResultsWriteError when it cannot be written: the game fails."""
         if self._rec is None:
             return
         try:
             self._finish(result)
+        except ResultsWriteError:
+            raise
         except Exception as exc:
             self._fail("finishing", exc)
 
     def abort(self, error: BaseException) -> None:
         """Send what is buffered, an ERROR event and the error (property ``failure``),
-        close the file and rename it to ``<game_id>.failed.rrd``."""
+        close the recording and write it to ``<game_id>.failed.rrd`` (a write that fails
+        is a warning: the game has failed already)."""
         if self._rec is None:
             return
         try:
@@ -163,7 +180,7 @@ class RerunRecorder(Recorder):
     # ---------------------------------------------------------- start and the end
 
     def _start(self, out_dir: Path, game_id: str, properties: dict[str, Any]) -> None:
-        out_dir.mkdir(parents=True, exist_ok=True)
+        make_dir(out_dir)
         self._game = (out_dir, game_id)
         self.path = recording_path(out_dir, game_id, PARTIAL)
         rec = rr.RecordingStream(
@@ -172,11 +189,10 @@ class RerunRecorder(Recorder):
         self._rec = rec
         # Wall-clock time would only make recordings of one game differ from run to run.
         rr.set_log_time_enabled(False, recording=rec)
-        sinks = [rr.FileSink(str(self.path))]
+        self._stream = rec.binary_stream()
         if self.config.spawn:
             rr.spawn(connect=False)
-            sinks.append(rr.GrpcSink())
-        rec.set_sinks(*sinks)
+            rec.set_sinks(rr.GrpcSink(), self._stream)
         rec.send_recording_name(recording_name(game_id, properties))
         send_property(rec, "config", flat_config(properties))
         log_static(rec, self.context, properties)
@@ -207,13 +223,18 @@ class RerunRecorder(Recorder):
         self._close(FAILED)
 
     def _close(self, status: str) -> None:
-        """Close the stream and rename the file to its name for ``status``. Closing the
-        file sink waits for its writer: a write error (full disk) raises here, and the
-        file keeps its partial name."""
-        self._rec.disconnect()
-        self._rec = None
+        """Close the stream and write its bytes to the file named for ``status``, through
+        the partial name. ResultsWriteError naming the file when rerun-sdk does not
+        deliver them or the write fails; no file is left then."""
+        rec, stream, self._rec, self._stream = self._rec, self._stream, None, None
         final = recording_path(*self._game, status)
-        os.replace(self.path, final)
+        try:
+            data = stream.read(flush=True, flush_timeout_sec=FLUSH_TIMEOUT)
+        except Exception as exc:
+            raise ResultsWriteError(f"Could not write the recording {final}: {exc}") from None
+        finally:
+            rec.disconnect()
+        write_atomic(final, data or b"", staging=self.path)
         self.path = final
 
     def _fail(self, action: str, exc: Exception) -> None:
@@ -224,7 +245,7 @@ class RerunRecorder(Recorder):
         )
         log.warning(message)
         warnings.warn(message, RuntimeWarning, stacklevel=3)
-        rec, self._rec = self._rec, None
+        rec, self._rec, self._stream = self._rec, None, None
         if rec is not None:
             try:
                 rec.disconnect()
