@@ -108,6 +108,9 @@ def check_playable(scenario: Scenario, settings: EnvSettings) -> None:
         value = getattr(scenario.configs["detector"], key)
         if value != off:
             refuse(f"detector.{key}", value, repr(off))
+    for key, size in zip(("team.pursuers", "team.evaders"), scenario.team_size):
+        if size != 1:
+            refuse(key, size, "1 (a team game is the PettingZoo env's, pegame.envs.parallel)")
     if scenario.settings.turn_order != "simultaneous":
         refuse("game.turn_order", scenario.settings.turn_order, "simultaneous")
     if settings.belief:
