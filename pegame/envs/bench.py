@@ -113,7 +113,7 @@ def bench_vector_env(
     from pegame.vector.state import PARALLEL_GAMES
 
     rng = np.random.default_rng(seed)
-    threads = numba.config.NUMBA_NUM_THREADS
+    threads = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets its options at import, its stubs have none
     single = parallel_env(overrides=overrides, **settings)
     single.reset(seed=seed)
     single.step({agent: np.zeros(2, np.float32) for agent in single.possible_agents})
@@ -134,7 +134,7 @@ def bench_vector_env(
     smart = vector_env(smart_envs, overrides=overrides, opponent="smart", **settings)
     smart.reset(seed=seed)
     smart.step(np.zeros((smart_envs, 2), np.float32))
-    per_round = {"single": [], "core": [], "all": [], "smart": []}
+    per_round: dict[str, list[float]] = {"single": [], "core": [], "all": [], "smart": []}
     batch = 4
     played = 1
     deadline = time.perf_counter() + seconds

@@ -22,6 +22,7 @@ after every step; and at the end ``metrics``, the game's
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import overload
 
 import numpy as np
 from omegaconf import DictConfig
@@ -33,6 +34,12 @@ from pegame.game import Scenario
 from pegame.loop import TickLoop, nearest
 
 
+@overload
+def check_seed(seed: int) -> int: ...
+@overload
+def check_seed(seed: None) -> None: ...
+@overload
+def check_seed(seed: int | None) -> int | None: ...
 def check_seed(seed: int | None) -> int | None:
     """``seed`` if it is None or a non-negative integer, else ValueError."""
     if seed is not None and (

@@ -26,7 +26,8 @@ summed tick by tick (:mod:`pegame.vector.metrics`).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any, Literal, overload
 
 import numpy as np
 from gymnasium import spaces
@@ -48,6 +49,9 @@ VECTOR_ROLES = ("pursuer", "evader", "both")
 class _Batch:
     """What the batched envs share: the batched game of ``roles``, seeding, actions,
     autoreset and infos."""
+
+    #: gymnasium's VectorEnv._add_info, which each batched env has
+    _add_info: Callable[[dict[str, Any], dict[str, Any], int], dict[str, Any]]
 
     def _setup(self, num_envs, config, overrides, opponents, roles, settings) -> None:
         self.settings = env_settings(**settings)
@@ -280,13 +284,41 @@ class SelfPlayVectorEnv(_Batch):
         """Nothing to release."""
 
 
+@overload
+def vector_env(
+    num_envs: int,
+    config: DictConfig | None = None,
+    overrides: Sequence[str] = (),
+    opponent: str | None = None,
+    role: Literal["pursuer", "evader"] = "pursuer",
+    **settings: Any,
+) -> PursuitVectorEnv | EvasionVectorEnv: ...
+@overload
+def vector_env(
+    num_envs: int,
+    config: DictConfig | None = None,
+    overrides: Sequence[str] = (),
+    opponent: None = None,
+    *,
+    role: Literal["both"],
+    **settings: Any,
+) -> SelfPlayVectorEnv: ...
+@overload
 def vector_env(
     num_envs: int,
     config: DictConfig | None = None,
     overrides: Sequence[str] = (),
     opponent: str | None = None,
     role: str = "pursuer",
-    **settings,
+    **settings: Any,
+) -> PursuitVectorEnv | EvasionVectorEnv | SelfPlayVectorEnv: ...
+def vector_env(
+    num_envs: int,
+    config: DictConfig | None = None,
+    overrides: Sequence[str] = (),
+    opponent: str | None = None,
+    role: str = "pursuer",
+    **settings: Any,
 ) -> PursuitVectorEnv | EvasionVectorEnv | SelfPlayVectorEnv:
     """``num_envs`` games stepped together for a learning ``role``: 'pursuer'
     (:class:`PursuitVectorEnv`), 'evader' (:class:`EvasionVectorEnv`), both against
