@@ -49,15 +49,17 @@ def _ramp(current: float, target: float, limit: float) -> float:
 
 
 def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
-    """Exact unicycle integration of (v, w) held for dt seconds from ``pose``."""
-    theta = pose.theta + cmd.w * dt
-    if abs(cmd.w) < 1e-9:
-        dx, dy = cmd.v * dt * math.cos(pose.theta), cmd.v * dt * math.sin(pose.theta)
-    else:
-        radius = cmd.v / cmd.w
-        dx = radius * (math.sin(theta) - math.sin(pose.theta))
-        dy = -radius * (math.cos(theta) - math.cos(pose.theta))
-    return Pose(pose.x + dx, pose.y + dy, wrap_angle(theta))
+    """Exact unicycle integration of (v, w) held for dt seconds from ``pose``.
+
+    The arc's chord, v dt sin(h) / h long for the half turn h = w dt / 2, along the mean
+    heading theta + h: accurate to round-off for every turn rate (the difference of sines
+    times v / w, the textbook form, loses digits to cancellation as w nears 0).
+    """
+    half = 0.5 * cmd.w * dt
+    chord = cmd.v * dt * (math.sin(half) / half if half != 0.0 else 1.0)
+    heading = pose.theta + half
+    dx, dy = chord * math.cos(heading), chord * math.sin(heading)
+    return Pose(pose.x + dx, pose.y + dy, wrap_angle(pose.theta + cmd.w * dt))
 
 
 @njit(cache=True)
