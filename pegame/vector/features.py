@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from pegame.envs.crop import lattice_crop
+from pegame.envs.crop import CropLattice, CropScratch, lattice_crop
 from pegame.envs.observations import AGE_SCALE
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.numerics import cell_by_division, hypot, wrap_angle
@@ -68,9 +68,9 @@ def crop_into(world, x, y, theta, out, at, cells):
     and on poses whose cells lie on cell edges."""
     c, s = math.cos(theta), math.sin(theta)
     table, centres, frame = world.crop_table, world.crop_centres, world.crop_frame
-    columns = np.empty((2, centres.size))
-    width = world.pooled.shape[1]
-    if lattice_crop(table, centres, frame, width, x, y, c, s, out, at, cells, columns):
+    lattice = CropLattice(table, centres, frame, world.pooled.shape[1])
+    scratch = CropScratch(cells, np.empty((2, centres.size)))
+    if lattice_crop(lattice, (x, y, c, s), out, at, scratch):
         return False
     _divided_crop(world, x, y, c, s, out, at)
     return True
@@ -118,10 +118,13 @@ _BLOCK = 64
 def _features_block(world, rules, state, out, pursuer, block):
     """The rows of the games of ``block``: the arrays are taken out of the NamedTuples
     once per block, not per game."""
-    cells = np.empty(world.crop_x.size, np.int32)
-    columns = np.empty((2, world.crop_centres.size))
-    extent, table, centres = world.extent, world.crop_table, world.crop_centres
-    frame, width = world.crop_frame, world.pooled.shape[1]
+    scratch = CropScratch(
+        np.empty(world.crop_x.size, np.int32), np.empty((2, world.crop_centres.size))
+    )
+    lattice = CropLattice(
+        world.crop_table, world.crop_centres, world.crop_frame, world.pooled.shape[1]
+    )
+    extent = world.extent
     poses, detected, has_seen = state.poses, state.detected, state.has_seen
     seen, steps = state.seen, state.steps
     far, dt = rules.camera[FAR], rules.control_dt
@@ -134,7 +137,7 @@ def _features_block(world, rules, state, out, pursuer, block):
             _evader_row(extent, poses, game, row)
         x, y, theta = poses[game, role, 0], poses[game, role, 1], poses[game, role, 2]
         c, s = math.cos(theta), math.sin(theta)
-        if not lattice_crop(table, centres, frame, width, x, y, c, s, row, at, cells, columns):
+        if not lattice_crop(lattice, (x, y, c, s), row, at, scratch):
             _divided_crop(world, x, y, c, s, row, at)
 
 

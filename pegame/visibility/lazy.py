@@ -115,23 +115,25 @@ class VisibilityRegion:
             return self._whole.holds(cells)
         return _holds(np.asarray(cells, dtype=np.int64), *self._kernel_arguments())
 
-    def _kernel_arguments(self) -> tuple[Sight, Eye, Rays]:
-        """The grid, pose and camera as :func:`_mask_over` and :func:`_holds` take them."""
+    def _kernel_arguments(self) -> tuple[tuple, tuple, tuple]:
+        """The grid, pose and camera as :func:`_mask_over` and :func:`_holds` take them:
+        :class:`Sight`, :class:`Eye` and :class:`Rays` as plain tuples (numba dispatches
+        a NamedTuple argument in about 0.6 us, a plain tuple in 0.05-0.13 us; the particle
+        filter asks once per tick)."""
         grid, pose, camera = self.grid, self.pose, self.camera
         angles, distances, first = ray_tables(camera)
-        return (
-            Sight(grid.blocked, grid.kernel_frame, float(grid.origin[2])),
-            Eye(float(pose.x), float(pose.y), float(pose.theta)),
-            Rays(
-                angles,
-                distances,
-                first,
-                camera.angle_step,
-                camera.distance_step,
-                camera.fov,
-                camera.far,
-            ),
+        sight = Sight(grid.blocked, grid.kernel_frame, float(grid.origin[2]))
+        eye = Eye(float(pose.x), float(pose.y), float(pose.theta))
+        rays = Rays(
+            angles,
+            distances,
+            first,
+            camera.angle_step,
+            camera.distance_step,
+            camera.fov,
+            camera.far,
         )
+        return tuple(sight), tuple(eye), tuple(rays)
 
 
 @njit(cache=True)
@@ -153,7 +155,8 @@ def _mask_over(sight, eye, rays, block):
 def _holds(cells, sight, eye, rays):
     """Kernel of :meth:`VisibilityRegion.holds` for a region not yet computed whole."""
     blocked, frame, yaw = sight
-    near, block = _near_wedge(cells, blocked.shape[1], eye, frame, yaw, rays.fov, rays.far)
+    _, _, _, _, _, fov, far = rays
+    near, block = _near_wedge(cells, blocked.shape[1], eye, frame, yaw, fov, far)
     if block[1] < block[0]:
         return near  # all False
     mask = _mask_over(sight, eye, rays, block)

@@ -79,14 +79,12 @@ def test_both_routes_give_the_reference_cells(scene: Scene) -> None:
     grid, cells, resolution, (x, y, theta) = scene
     crop = LocalCrop(grid, cells, resolution)
     expected = local_crop_reference(grid, x, y, theta, cells, resolution).ravel()
-    c, s = math.cos(theta), math.sin(theta)
+    pose = (x, y, math.cos(theta), math.sin(theta))
     lattice = np.full(crop.size, np.nan, dtype=np.float32)
-    args = (crop._table, crop._centres, crop._frame, grid.width, x, y, c, s, lattice, 0)
-    if lattice_crop(*args, crop._cells, crop._columns):
+    if lattice_crop(crop._lattice, pose, lattice, 0, crop._scratch):
         assert np.array_equal(lattice, expected)
     divided = np.full(crop.size, np.nan, dtype=np.float32)
-    gx, gy, gc, gs, rotate, res = crop._origin
-    _crop(crop._pooled, crop._off_x, crop._off_y, x, y, c, s, gx, gy, gc, gs, rotate, res, divided)
+    _crop(crop._samples, grid.kernel_frame, pose, divided)
     assert np.array_equal(divided, expected)
 
 

@@ -288,9 +288,8 @@ def test_crop_on_cell_edges_takes_the_division_and_matches_the_reference(yaw):
         expected = local_crop_reference(grid, x, y, theta, 32, 0.2)
         assert np.array_equal(crop(x, y, theta).reshape(32, 32), expected)
         out = np.empty(crop.size, dtype=np.float32)
-        c, s = math.cos(theta), math.sin(theta)
-        args = (crop._table, crop._centres, crop._frame, grid.width, x, y, c, s, out, 0)
-        undecided += not lattice_crop(*args, crop._cells, crop._columns)
+        pose = (x, y, math.cos(theta), math.sin(theta))
+        undecided += not lattice_crop(crop._lattice, pose, out, 0, crop._scratch)
     assert undecided > 0  # these poses exercise the division, not only the lattice
 
 
