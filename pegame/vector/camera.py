@@ -61,7 +61,7 @@ _CHUNK = 32
 
 
 @njit(cache=True, inline="always")
-def _sample_cells(frame, height, width, ax, ay, dx, dy, count, start, size, cells, rotated):
+def _sample_cells(frame, height, width, ax, ay, bx, by, count, start, size, cells, rotated):
     """The cells (1 + flat index, 0 off the grid) of samples start..start + size - 1 of
     the segment into ``cells`` by :func:`pegame.numerics.cell_by_product`; returns
     whether all are decided. Inlined with ``rotated`` a constant (no branch in the loop).
@@ -69,19 +69,21 @@ def _sample_cells(frame, height, width, ax, ay, dx, dy, count, start, size, cell
     inverse = 1.0 / frame[RESOLUTION]
     decided = True
     for j in range(size):
-        u, v = _sample_point(frame, ax, ay, dx, dy, start + j, count, rotated)
+        u, v = _sample_point(frame, ax, ay, bx, by, start + j, count, rotated)
         cells[j], ok = cell_by_product(u, v, inverse, height, width)
         decided &= ok
     return decided
 
 
 @njit(cache=True, inline="always")
-def _sample_point(frame, ax, ay, dx, dy, k, count, rotated):
+def _sample_point(frame, ax, ay, bx, by, k, count, rotated):
     """Grid-frame point (u, v) (m) of sample k of count along the segment from (ax, ay)
-    by (dx, dy), as :func:`pegame.visibility.sight._segment_clear` places it."""
-    t = 1.0 if k == count else k * (1.0 / count)
-    u = ax + t * dx - frame[OX]
-    v = ay + t * dy - frame[OY]
+    to (bx, by), as :func:`pegame.visibility.sight._segment_clear` places it (the last
+    one at (bx, by) itself)."""
+    t = k * (1.0 / count)
+    x, y = (bx, by) if k == count else (ax + t * (bx - ax), ay + t * (by - ay))
+    u = x - frame[OX]
+    v = y - frame[OY]
     if rotated:
         u, v = frame[COS_YAW] * u + frame[SIN_YAW] * v, -frame[SIN_YAW] * u + frame[COS_YAW] * v
     return u, v
@@ -101,21 +103,20 @@ def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
     height, width = blocked.shape
     rotated = frame[ROTATED] != 0.0
     count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
-    dx, dy = bx - ax, by - ay
     cells = np.empty(_CHUNK, np.int64)
     for start in range(0, count + 1, _CHUNK):
         size = min(_CHUNK, count + 1 - start)
         if rotated:
             decided = _sample_cells(
-                frame, height, width, ax, ay, dx, dy, count, start, size, cells, True
+                frame, height, width, ax, ay, bx, by, count, start, size, cells, True
             )
         else:
             decided = _sample_cells(
-                frame, height, width, ax, ay, dx, dy, count, start, size, cells, False
+                frame, height, width, ax, ay, bx, by, count, start, size, cells, False
             )
         if not decided:
             for j in range(size):
-                u, v = _sample_point(frame, ax, ay, dx, dy, start + j, count, rotated)
+                u, v = _sample_point(frame, ax, ay, bx, by, start + j, count, rotated)
                 cells[j] = cell_by_division(u, v, frame[RESOLUTION], height, width)
         for j in range(size):
             if values[cells[j]]:

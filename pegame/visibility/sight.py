@@ -19,16 +19,17 @@ import numpy as np
 from numba import njit
 
 from pegame.grid import OccupancyGrid, cell_blocked, point_cell
-from pegame.types import Camera, Pose, wrap_angle
+from pegame.types import XY, Camera, Pose, wrap_angle
 
 
-def _line_of_sight_reference(grid: OccupancyGrid, a_xy, b_xy, step: float) -> bool:
+def _line_of_sight_reference(grid: OccupancyGrid, a_xy: XY, b_xy: XY, step: float) -> bool:
     """Plain numpy reference of :func:`line_of_sight` (``step`` given, > 0)."""
     a = np.asarray(a_xy, dtype=float)
     b = np.asarray(b_xy, dtype=float)
     count = max(1, math.ceil(float(np.hypot(*(b - a))) / step))
     t = np.linspace(0.0, 1.0, count + 1)[:, None]
     points = a + t * (b - a)
+    points[-1] = b  # the end point itself: a + (b - a) may round into another cell
     rows, cols = grid.world_to_cell(points[:, 0], points[:, 1])
     if not np.all(grid.contains(rows, cols)):
         return False
@@ -38,19 +39,19 @@ def _line_of_sight_reference(grid: OccupancyGrid, a_xy, b_xy, step: float) -> bo
 @njit(cache=True)
 def _segment_clear(blocked, ax, ay, bx, by, step, frame):
     """Kernel of :func:`line_of_sight`: the same samples as the numpy reference, where
-    ``np.linspace(0, 1, count + 1)`` gives t = k * (1 / count) and exactly 1 at the end."""
+    ``np.linspace(0, 1, count + 1)`` gives t = k * (1 / count), and the end point itself."""
     count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
     dx, dy = bx - ax, by - ay
     dt = 1.0 / count
     for k in range(count + 1):
-        t = 1.0 if k == count else k * dt
-        row, col = point_cell(ax + t * dx, ay + t * dy, frame)
+        x, y = (bx, by) if k == count else (ax + k * dt * dx, ay + k * dt * dy)
+        row, col = point_cell(x, y, frame)
         if cell_blocked(blocked, row, col):
             return False
     return True
 
 
-def line_of_sight(grid: OccupancyGrid, a_xy, b_xy, step: float | None = None) -> bool:
+def line_of_sight(grid: OccupancyGrid, a_xy: XY, b_xy: XY, step: float | None = None) -> bool:
     """True when the segment from ``a_xy`` to ``b_xy`` (map frame, m) crosses no blocked cell.
 
     The segment is sampled at most ``step`` m apart (default: half the grid resolution),
@@ -67,7 +68,7 @@ def line_of_sight(grid: OccupancyGrid, a_xy, b_xy, step: float | None = None) ->
     return _segment_clear(grid.blocked, ax, ay, bx, by, step, grid.kernel_frame)
 
 
-def in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, point_xy) -> bool:
+def in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, point_xy: XY) -> bool:
     """True when the camera at ``pose`` sees the map-frame point ``point_xy`` (m).
 
     The continuous counterpart of :func:`visibility_region`: the point's bearing from the
@@ -88,7 +89,9 @@ def in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, point_xy) -> bool:
 SILHOUETTE = (0.0, -1.0, 1.0, -0.5, 0.5)
 
 
-def body_in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, centre_xy, radius: float) -> bool:
+def body_in_view(
+    grid: OccupancyGrid, camera: Camera, pose: Pose, centre_xy: XY, radius: float
+) -> bool:
     """True when the camera at ``pose`` sees any part of a body: an upright cylinder of
     ``radius`` m standing at the map-frame point ``centre_xy`` (m).
 
