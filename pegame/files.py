@@ -20,7 +20,7 @@ from pegame.errors import ResultsWriteError
 def write_failed(path: str | os.PathLike, exc: OSError) -> ResultsWriteError:
     """The error for a write to ``path`` that failed with ``exc``."""
     error = ResultsWriteError(
-        f"Could not write {path}: {exc.strerror or exc}. Free space or choose another "
+        f"Could not write to {path}: {exc.strerror or exc}. Free space or choose another "
         f"output directory, then run again (resume=true keeps the games stored)."
     )
     error.strerror = exc.strerror or str(exc)
