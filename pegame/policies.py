@@ -224,8 +224,9 @@ class PolicyPlayer:
         """The strategy's plan: none (a policy commands velocities directly)."""
         return Plan(info={"command": (self.command.v, self.command.w)})
 
-    def control(self, observation) -> Velocity:
-        """The command for this control tick from the role's ``observation``."""
+    def control(self, observation: Any) -> Velocity:
+        """The command for this control tick from the role's ``observation`` (a
+        PursuerObservation or an EvaderObservation, as this role's features take it)."""
         self.features.update(observation)
         if self.tick % self.every == 0:
             action = self.policy(self.features(observation))

@@ -24,6 +24,9 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     from typing_extensions import dataclass_transform
 
+#: a map-frame point (x, y), m: a pair of floats or a numpy array of two
+XY = tuple[float, float] | np.ndarray
+
 
 def wrap_angle(angle: float) -> float:
     """Wrap an angle in radians to (-pi, pi]."""

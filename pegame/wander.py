@@ -39,7 +39,7 @@ class Wanderer:
 
     def __init__(
         self,
-        grid,
+        grid: OccupancyGrid,
         body: Body,
         rng: np.random.Generator,
         stuck_distance: float = 0.05,

@@ -25,7 +25,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pegame.api import Detector
+import numpy as np
+
+from pegame.api import Context, Detector
 from pegame.detectors.perception import Perception, PerceptionConfig, hidden_fraction, pinhole_box
 from pegame.errors import require
 from pegame.types import Detection, SensorFrame, wrap_angle
@@ -53,7 +55,7 @@ class OracleDetector(Detector):
                     getattr(self, key),
                 )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         self.perception = Perception(
             config, context, rng, config.evader_height, config.camera_height

@@ -52,13 +52,17 @@ import math
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
 from pegame.errors import ConfigError, require
-from pegame.types import BoundingBox, Detection, Pose, wrap_angle
+from pegame.types import XY, BoundingBox, Camera, Detection, Pose, wrap_angle
 from pegame.visibility import SILHOUETTE, in_view
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from pegame.api import Context
+    from pegame.grid import OccupancyGrid
 
 #: s; times this close count as equal (capture and delivery schedules)
 TIME_TOLERANCE = 1e-9
@@ -121,7 +125,7 @@ class PerceptionConfig:
             value = getattr(self, name)
             require(math.isfinite(value) and value >= 0, name, f"a number >= 0 {unit}", value)
 
-    def check_context(self, context) -> None:
+    def check_context(self, context: Context) -> None:
         """The checks that need the game's camera and control period (``context``): a
         ConfigError naming the key."""
         near, reach = context.camera.near, detection_range(self, context.camera)
@@ -152,12 +156,20 @@ class PerceptionConfig:
             )
 
 
-def detection_range(config: PerceptionConfig, camera) -> float:
+def detection_range(config: PerceptionConfig, camera: Camera) -> float:
     """The detection range (m): ``detection_range``, or the camera's ``far`` when null."""
     return camera.far if config.detection_range is None else config.detection_range
 
 
-def pinhole_box(camera, bearing, distance, depth, radius, height, camera_height) -> BoundingBox:
+def pinhole_box(
+    camera: Camera,
+    bearing: float,
+    distance: float,
+    depth: float,
+    radius: float,
+    height: float,
+    camera_height: float,
+) -> BoundingBox:
     """The image box (px) of an upright cylinder of ``radius`` and ``height`` m standing at
     ``distance`` m (horizontal, to its axis) and ``bearing`` rad (left of the optical axis),
     ``depth`` m along the axis, seen by the pinhole ``camera`` mounted ``camera_height`` m
@@ -171,7 +183,9 @@ def pinhole_box(camera, bearing, distance, depth, radius, height, camera_height)
     return BoundingBox(left, top, right - left, bottom - top)
 
 
-def hidden_fraction(grid, camera, pose: Pose, centre_xy, radius: float) -> float:
+def hidden_fraction(
+    grid: OccupancyGrid, camera: Camera, pose: Pose, centre_xy: XY, radius: float
+) -> float:
     """The fraction in [0, 1] of the silhouette points of a body (an upright cylinder of
     ``radius`` m at the map-frame point ``centre_xy``) that the camera at ``pose`` does not
     see: the same points, across the line of sight, as :func:`pegame.visibility.body_in_view`."""
@@ -197,7 +211,7 @@ class Perception:
     def __init__(
         self,
         config: PerceptionConfig,
-        context,
+        context: Context,
         rng: np.random.Generator,
         body_height: float = PERSON_HEIGHT,
         camera_height: float = 0.4,

@@ -67,7 +67,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import maximum_filter
 
-from pegame.api import Evader, EvaderObservation
+from pegame.api import Context, Evader, EvaderObservation
 from pegame.errors import require
 from pegame.navigation import PathFollower, Planner
 from pegame.types import STOP, Plan, Pose, Velocity
@@ -120,7 +120,7 @@ class ElusiveEvader(Evader):
                 self.sight_angle_step,
             )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         grid = context.grid
         self.planner = Planner.shared(grid, context.evader.radius)

@@ -70,7 +70,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import distance_transform_edt
 
-from pegame.api import Evader, EvaderObservation
+from pegame.api import Context, Evader, EvaderObservation
 from pegame.errors import require
 from pegame.evaders.escape import (
     DISTANCES,
@@ -111,7 +111,7 @@ class SmartEvader(Evader):
                 self.candidate_stride,
             )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         grid = context.grid
         self.planner = Planner.shared(grid, context.evader.radius)

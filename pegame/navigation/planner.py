@@ -37,6 +37,7 @@ from pegame.navigation.search import (
     dijkstra,
     pad_flat,
 )
+from pegame.types import XY
 
 #: grids with at least this many cells round A*'s keys by default (see Planner); the
 #: paper's maps have at most 120 000
@@ -161,7 +162,7 @@ class Planner:
         self._landmarks: np.ndarray | None = None  # see _landmark_table
 
     @classmethod
-    def shared(cls, grid: OccupancyGrid, radius: float, **options) -> Planner:
+    def shared(cls, grid: OccupancyGrid, radius: float, **options: Any) -> Planner:
         """The planner for ``grid``, ``radius`` and ``options`` (the other constructor
         arguments), built at the first call and returned again by every later call with
         equal parameters for as long as the grid exists. Its arrays are read-only."""
@@ -174,16 +175,16 @@ class Planner:
 
     # -- cells
 
-    def _cell(self, xy) -> tuple[int, int]:
+    def _cell(self, xy: XY) -> tuple[int, int]:
         """The (row, col) containing map point xy (m), clamped into the grid."""
         row, col = self.grid.world_to_cell(xy[0], xy[1])
         return min(max(row, 0), self.grid.height - 1), min(max(col, 0), self.grid.width - 1)
 
-    def _is_traversable(self, xy) -> bool:
+    def _is_traversable(self, xy: XY) -> bool:
         row, col = self.grid.world_to_cell(xy[0], xy[1])
         return bool(self.grid.contains(row, col)) and bool(self.traversable[row, col])
 
-    def _source_cell(self, xy) -> tuple[int, int] | None:
+    def _source_cell(self, xy: XY) -> tuple[int, int] | None:
         """xy's cell if traversable, else the traversable cell whose centre is nearest to the
         centre of xy's cell (clamped into the grid); None if no cell is traversable."""
         if not self._any_traversable:
@@ -203,13 +204,13 @@ class Planner:
             self._nearest = read_only(nearest)
         return self._nearest
 
-    def nearest_traversable(self, xy) -> tuple[float, float] | None:
+    def nearest_traversable(self, xy: XY) -> tuple[float, float] | None:
         """Map-frame centre (m) of the traversable cell nearest to xy's cell (xy itself
         when its cell is traversable, up to the cell centre); None if none is traversable."""
         cell = self._source_cell(xy)
         return None if cell is None else self.grid.cell_to_world(*cell)
 
-    def reachable(self, xy) -> np.ndarray:
+    def reachable(self, xy: XY) -> np.ndarray:
         """Bool (H, W): the traversable cells connected to xy's cell (or to the nearest
         traversable cell when xy's cell is not traversable)."""
         cell = self._source_cell(xy)
@@ -219,7 +220,7 @@ class Planner:
 
     # -- searches
 
-    def distance_field(self, xy, weighted: bool = False) -> np.ndarray:
+    def distance_field(self, xy: XY, weighted: bool = False) -> np.ndarray:
         """Float64 (H, W): least path cost (m) from xy's cell to every cell over traversable
         cells, np.inf where unreachable. Unweighted, this is the geodesic distance; weighted,
         each step costs its length times the mean multiplier of its two cells. When xy's
@@ -288,7 +289,7 @@ class Planner:
             self._astar_scratch = AStarScratch.empty(self._allowed.size)
         return self._astar_scratch
 
-    def _snap_goal(self, goal_xy, label: int) -> tuple[int, int] | None:
+    def _snap_goal(self, goal_xy: XY, label: int) -> tuple[int, int] | None:
         """The cell with ``label`` whose centre is nearest to goal_xy and within goal_snap."""
         res = self.grid.resolution
         row, col = self.grid.world_to_cell(goal_xy[0], goal_xy[1])
@@ -308,7 +309,7 @@ class Planner:
             return None
         return int(rows[best]), int(cols[best])
 
-    def plan(self, start_xy, goal_xy) -> PathResult:
+    def plan(self, start_xy: XY, goal_xy: XY) -> PathResult:
         """Minimum weighted cost path from start_xy to goal_xy (map frame, m); never raises.
 
         A start outside the traversable cells (an agent touching the inflation zone) plans

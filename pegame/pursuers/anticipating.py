@@ -63,7 +63,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pegame.api import PursuerObservation
+from pegame.api import Context, PursuerObservation
 from pegame.errors import require
 from pegame.pursuers.smart import LOOKAHEAD_TIME, SEARCH, TRACK, SmartPursuer
 from pegame.types import Detection, Plan, Pose, Velocity, clamp, wrap_angle
@@ -112,7 +112,7 @@ class AnticipatingPursuer(SmartPursuer):
                 self.look_angle_step,
             )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         # The camera turned all the way round: the line of sight the pursuer could look along.
         self._all_round = dataclasses.replace(

@@ -46,7 +46,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from pegame.api import PursuerObservation, PursuerTeam
+from pegame.api import Context, PursuerObservation, PursuerTeam
 from pegame.errors import require
 from pegame.evaders.escape import EscapeSearch
 from pegame.navigation import Planner
@@ -145,7 +145,7 @@ class CooperativePursuer(SmartPursuer):
                 self.escape_margin,
             )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         grid = context.grid
         self.escape = EscapeSearch(

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from pegame.api import Pursuer, PursuerObservation
+from pegame.api import Context, Pursuer, PursuerObservation
 from pegame.errors import require
 from pegame.grid import OccupancyGrid, point_cell
 from pegame.navigation import PathFollower, Planner, shared_inflation
@@ -81,7 +81,7 @@ class SmartPursuer(Pursuer):
                 self.scan_rate,
             )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         self.planner = Planner.shared(context.grid, context.pursuer.radius)
         self.follower = PathFollower(context.pursuer)

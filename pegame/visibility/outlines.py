@@ -23,8 +23,9 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
-from pegame.grid import per_grid, read_only
+from pegame.grid import OccupancyGrid, per_grid, read_only
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, SIN_YAW
 from pegame.navigation.inflation import shared_obstacle_distance
 from pegame.types import Camera
@@ -136,7 +137,14 @@ _outlines_kernel = njit(cache=True)(outlines_reference)
 
 
 def visibility_outlines(
-    grid, xs, ys, thetas, camera: Camera, rays: int, z: float = 0.0, compiled: bool = True
+    grid: OccupancyGrid,
+    xs: ArrayLike,
+    ys: ArrayLike,
+    thetas: ArrayLike,
+    camera: Camera,
+    rays: int,
+    z: float = 0.0,
+    compiled: bool = True,
 ) -> np.ndarray:
     """(P, rays + NEAR_ARC_POINTS + 1, 3) float32: closed polygons (map frame, m, at height
     z) around the visibility regions of ``camera`` at P poses (xs, ys, thetas) (m, m, rad)
@@ -156,7 +164,7 @@ def visibility_outlines(
     )
 
 
-def free_runs(grid) -> np.ndarray:
+def free_runs(grid: OccupancyGrid) -> np.ndarray:
     """uint8 (H, W): 0 on blocked cells; on a free cell, how many samples one cell apart
     along any ray from any point of the cell are sure to be free, this one included.
 
@@ -168,7 +176,7 @@ def free_runs(grid) -> np.ndarray:
     return per_grid(grid, ("visibility.outlines", "free runs"), _free_runs)
 
 
-def _free_runs(grid) -> np.ndarray:
+def _free_runs(grid: OccupancyGrid) -> np.ndarray:
     clearance = shared_obstacle_distance(grid) / grid.resolution  # cells
     runs = np.where(grid.blocked, 0, 1 + np.clip(np.floor(clearance - 1.5), 0, 254))
     return read_only(runs.astype(np.uint8))

@@ -152,7 +152,9 @@ def visibility_region(grid: OccupancyGrid, pose: Pose, camera: Camera) -> np.nda
     return whole_region(grid, pose, camera)[0]
 
 
-def whole_region(grid: OccupancyGrid, pose: Pose, camera: Camera):
+def whole_region(
+    grid: OccupancyGrid, pose: Pose, camera: Camera
+) -> tuple[np.ndarray, tuple[int, int, int, int]]:
     """:func:`visibility_region`'s mask and the bounds (r0, r1, c0, c1) of its True
     cells, rows [r0, r1) and columns [c0, c1) (r1 <= r0 when there is none)."""
     _, distances, first = ray_tables(camera)
