@@ -21,9 +21,7 @@ import logging.handlers
 import os
 import signal
 import sys
-from collections.abc import Callable, Sequence
-from importlib.metadata import entry_points
-from importlib.resources import files
+from collections.abc import Callable
 from pathlib import Path
 
 import hydra
@@ -35,10 +33,10 @@ from omegaconf import DictConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
 from pegame import sweep
-from pegame.api import PLUGIN_KINDS
-from pegame.config import did_you_mean, register_schema
-from pegame.errors import JobDirectoryError, PegameError, PluginChoiceError
+from pegame.config import register_schema
+from pegame.errors import JobDirectoryError, PegameError
 from pegame.files import make_dir, write_atomic
+from pegame.overrides import check_overrides
 
 log = logging.getLogger("pegame")
 
@@ -155,57 +153,6 @@ def _app(cfg: DictConfig) -> int:
     return status
 
 
-def plugin_options(kind: str) -> list[str]:
-    """The config options of plugin group ``kind`` that Hydra finds on pegame's search
-    path: pegame's own ``conf/<kind>/*.yaml`` and those of plugin distributions."""
-    packages = ["pegame.conf", *(point.value for point in entry_points(group="pegame.configs"))]
-    options = set()
-    for package in packages:
-        try:
-            folder = files(package) / kind
-        except ModuleNotFoundError:
-            continue
-        if folder.is_dir():
-            options |= {item.name[:-5] for item in folder.iterdir() if item.name.endswith(".yaml")}
-    return sorted(options)
-
-
-def check_plugin_choices(args: Sequence[str]) -> None:
-    """PluginChoiceError, with the closest option, for ``kind=name`` on the command line
-    when ``name`` is no option of that plugin group (``pursuer=smrt``; every value of a
-    sweep ``pursuer=smart,smrt``). Skipped when the user adds config directories, whose
-    options only Hydra knows."""
-    from hydra.core.override_parser.overrides_parser import OverridesParser
-
-    if any(
-        a.startswith(("--config-dir", "-cd", "--config-path", "-cp", "hydra.searchpath"))
-        for a in args
-    ):
-        return
-    candidates = [a for a in args if "=" in a and not a.startswith("-")]
-    try:
-        parsed = OverridesParser.create().parse_overrides(candidates)
-    except Exception:
-        return
-    for override in parsed:
-        kind = override.key_or_group
-        if kind not in PLUGIN_KINDS or override.package or override.is_delete():
-            continue
-        values = (
-            list(override.sweep_string_iterator())
-            if override.is_sweep_override()
-            else [override.get_value_element_as_str()]
-        )
-        options = plugin_options(kind)
-        for value in values:
-            if value not in options:
-                raise PluginChoiceError(
-                    f"Unknown {kind} '{value}'.{did_you_mean(value, options)} Available: "
-                    f"{', '.join(options)}. A plugin option is a file {kind}/<name>.yaml in "
-                    f"pegame's conf or a plugin distribution's (see python -m pegame.catalog)."
-                )
-
-
 def _terminate(signum: int, frame: object) -> None:
     raise KeyboardInterrupt  # SIGTERM unwinds like Ctrl-C: the launcher stops its workers
 
@@ -218,13 +165,13 @@ def main() -> None:
     # background job, a test runner's worker), and an interrupt must still stop the sweep.
     signal.signal(signal.SIGINT, _terminate)
     try:
-        check_plugin_choices(sys.argv[1:])
+        check_overrides(sys.argv[1:])
         _app()
     except SystemExit as exc:
         if exc.code == 1 and isinstance(exc.__context__, (HydraException, OmegaConfBaseException)):
             sys.exit(sweep.BAD_INPUT)  # Hydra reported (and exited on) a bad command line
         raise
-    except PluginChoiceError as exc:
+    except PegameError as exc:
         print(f"pegame: error: {exc}", file=sys.stderr)  # before Hydra: no job log yet
         sys.exit(sweep.BAD_INPUT)
     except KeyboardInterrupt:

@@ -311,6 +311,9 @@ def compose(overrides: Sequence[str] = ()) -> DictConfig:
     from hydra import compose as hydra_compose
     from hydra import initialize_config_module
 
+    from pegame.overrides import check_overrides
+
+    check_overrides(overrides)
     register_schema()
     with initialize_config_module(config_module="pegame.conf", version_base=None):
         return hydra_compose(config_name="config", overrides=list(overrides))
