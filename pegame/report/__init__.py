@@ -1,11 +1,13 @@
-"""``python -m pegame.report DIR [DIR ...] [--out OUT]``: aggregate sweeps like the paper.
+"""``python -m pegame.report DIR [DIR ...] [--out OUT] [--metric NAME] [--paper]``:
+aggregate sweeps like the paper.
 
 Reads every ``results.jsonl`` below one or more Hydra multirun directories
 (:mod:`~pegame.report.load`), groups the games into cells, one per configuration
 (:mod:`~pegame.report.cells`: every setting that differs between the jobs is a factor;
 the paper's axes are environment x speed ratio v_p/v_e x pairing, the others are shown
-beside them), and per cell computes the mean tracking success rate with a 95%
-percentile-bootstrap confidence interval, the median and the standard deviation
+beside them), and per cell computes the mean of one measure (``--metric``, one of
+:data:`~pegame.report.measures.MEASURES`; the tracking success rate by default) with a
+95% percentile-bootstrap confidence interval, the median and the standard deviation
 (:mod:`~pegame.report.statistics`). It writes into the output directory
 
 - ``table1.md`` / ``table1.csv`` / ``table1.tex``: the paper's Table 1 with CIs and n, one
@@ -13,16 +15,26 @@ percentile-bootstrap confidence interval, the median and the standard deviation
   provenance (code versions, configurations, warnings) and with the failed cells, failed
   games, missing and unfinished jobs, duplicates and skipped lines;
 - ``fig5a_speed_ratio``, ``fig5b_environment``, ``fig8_pairing``: box plots like the
-  paper's Fig. 5 and Fig. 8, PNG and SVG, one panel per combination of the other factors
-  (:mod:`~pegame.report.figures`);
-- ``hypotheses.md``: the paper's three hypotheses, tested per combination of the other
-  factors (:mod:`~pegame.report.hypotheses`), unpaired (Mann-Whitney U) and, on the seeds
-  both pairings share, paired (Wilcoxon signed-rank, :mod:`~pegame.report.paired`);
+  paper's Fig. 5 and Fig. 8, PNG and SVG, one panel per combination of the other factors,
+  and ``curve_<factor>`` per numeric factor, the mean with its CI against the factor's
+  value (:mod:`~pegame.report.figures`);
+- ``hypotheses.md``: the paper's three hypotheses on the tracking rate (whatever the
+  measure), tested per combination of the other factors
+  (:mod:`~pegame.report.hypotheses`), unpaired (Mann-Whitney U) and, on the seeds both
+  pairings share, paired (Wilcoxon signed-rank, :mod:`~pegame.report.paired`);
+- ``estimation.md`` / ``.csv`` when the games carry an estimation error or N_eff: the
+  estimator's measures per cell (:mod:`~pegame.report.estimation`);
+- with ``--paper``: ``vs_paper.md`` / ``.csv``, our tracking rates beside the paper's
+  Table 1 with the difference (:mod:`~pegame.report.paper`);
 - with ``--compare FACTOR=A,B`` (repeatable): ``compare_<FACTOR>.md`` / ``.csv``, value B
   of one factor against value A per cell on common seeds (:mod:`~pegame.report.compare`);
 - ``report.json``: all of the above, machine-readable.
 
-Every file is written atomically; a file that cannot be written is a :class:`ReportError`.
+With a measure other than the tracking rate, the files of that measure (tables, figures,
+comparisons, report.json) carry its name, ``table1_<NAME>.md``, so they sit beside the
+tracking-rate report of the same directory. The stages are logged at INFO on the
+``pegame.report`` logger. Every file is written atomically; a file that cannot be written
+is a :class:`ReportError`.
 """
 
 from __future__ import annotations
@@ -54,15 +66,24 @@ from pegame.report.compare import (
     render_compare_csv,
     render_compare_md,
 )
+from pegame.report.estimation import (
+    carried,
+    estimation,
+    render_estimation_csv,
+    render_estimation_md,
+)
 from pegame.report.figures import figure_bytes, figures
 from pegame.report.hypotheses import (
     UNTESTED,
+    facet_text,
     hypotheses,
     hypotheses_per_facet,
     render_hypotheses,
     title,
 )
-from pegame.report.load import ReportError, Sweep, load_sweep
+from pegame.report.load import ReportError, Sweep, find_job_dirs, load_sweep
+from pegame.report.measures import MEASURES, TRACKING, Measure, MeasureError, measure
+from pegame.report.paper import render_paper_csv, render_paper_md, versus_paper
 from pegame.report.statistics import (
     ALPHA,
     BOOT_LEVEL,
@@ -84,7 +105,9 @@ from pegame.report.tables import (
 __all__ = [
     "ALPHA",
     "UNTESTED",
+    "MEASURES",
     "CompareError",
+    "MeasureError",
     "ReportError",
     "bootstrap_ci",
     "compare",
@@ -125,17 +148,32 @@ def provenance(games: list[dict[str, Any]], cells: list[Cell]) -> dict[str, Any]
     }
 
 
-def aggregate(sweep: Sweep, dirs: list[Path]) -> tuple[dict[str, Any], list[Cell]]:
-    """report.json's content and the cells."""
+def aggregate(
+    sweep: Sweep, dirs: list[Path], measured: Measure = TRACKING
+) -> tuple[dict[str, Any], list[Cell]]:
+    """report.json's content and the cells; the cells' statistics are of ``measured``,
+    the hypotheses of the tracking rate."""
     chosen = select(sweep.records)
     cells = group_cells(chosen.games, other_factors(chosen.games))
+    factors = list(cells[0].factors) if cells else []
+    log.info(
+        "%d games in %d cells%s; statistics of %s (%s bootstrap resamples per cell)",
+        len(chosen.games),
+        len(cells),
+        f", factors beside the paper's axes: {', '.join(factors)}" if factors else "",
+        measured.name,
+        f"{BOOT_RESAMPLES:,}",
+    )
+    described = [cell.summary(measured.name) for cell in cells]
+    log.info("testing hypotheses H1-H3 on the tracking rate")
     return {
         "sweep_dirs": [str(d) for d in dirs],
         "games": len(chosen.games),
+        "metric": measured.name,
         "bootstrap": {"resamples": BOOT_RESAMPLES, "level": BOOT_LEVEL, "seed": BOOT_SEED},
         "alpha": ALPHA,
-        "factors": list(cells[0].factors) if cells else [],
-        "cells": [cell.summary() for cell in cells],
+        "factors": factors,
+        "cells": described,
         "hypotheses": hypotheses_per_facet(cells),
         "provenance": provenance(chosen.games, cells),
         "failed_cells": sweep.invalid,
@@ -151,15 +189,51 @@ def aggregate(sweep: Sweep, dirs: list[Path]) -> tuple[dict[str, Any], list[Cell
     }, cells
 
 
+def named(name: str, measured: Measure) -> str:
+    """A file name of the measure's report: 'table1.md', or 'table1_mean_distance.md' for
+    a measure other than the tracking rate."""
+    if measured is TRACKING:
+        return name
+    stem, _, suffix = name.rpartition(".")
+    return f"{stem}_{measured.name}.{suffix}"
+
+
+def extra_tables(report: dict[str, Any], cells: list[Cell], paper: bool) -> dict[str, str]:
+    """estimation.md/.csv when the games carry the estimator's measures, vs_paper.md/.csv
+    with ``paper``; their content is added to ``report``."""
+    files: dict[str, str] = {}
+    if carried(cells):
+        log.info("tabulating the estimator's error, N_eff and resamplings")
+        report["estimation"] = estimation(cells)
+        files["estimation.md"] = render_estimation_md(report["estimation"])
+        files["estimation.csv"] = render_estimation_csv(report["estimation"])
+    if paper:
+        log.info("setting our tracking rates beside the paper's Table 1")
+        rates = (
+            report["cells"]
+            if report["metric"] == TRACKING.name
+            else [cell.summary(TRACKING.name) for cell in cells]
+        )
+        report["vs_paper"] = versus_paper(cells, rates)
+        files["vs_paper.md"] = render_paper_md(report["vs_paper"])
+        files["vs_paper.csv"] = render_paper_csv(report["vs_paper"])
+    return files
+
+
 def write_report(
     sweep_dirs: str | Path | list[str | Path],
     out_dir: str | Path | None = None,
     comparisons: Sequence[tuple[str, str, str]] = (),
+    metric: str = TRACKING.name,
+    paper: bool = False,
 ) -> dict[str, Any]:
     """Aggregate one or more sweep directories and write the tables, figures,
     hypotheses.md and report.json into ``out_dir`` (default: the sweep directory; required
     for several), and per (factor, A, B) of ``comparisons`` compare_<factor>.md / .csv
-    (:func:`~pegame.report.compare.compare`). Returns report.json's content."""
+    (:func:`~pegame.report.compare.compare`), all of the measure ``metric`` (file names
+    with its name unless it is the tracking rate); with ``paper`` also vs_paper.md / .csv.
+    Returns report.json's content."""
+    measured = measure(metric)
     dirs = [Path(d) for d in ([sweep_dirs] if isinstance(sweep_dirs, (str, Path)) else sweep_dirs)]
     if out_dir is None and len(dirs) != 1:
         raise ReportError(
@@ -173,25 +247,32 @@ def write_report(
             f"--compare names {', '.join(twice)} more than once: one comparison per factor "
             f"(each writes compare_<factor>.md)."
         )
-    report, cells = aggregate(load_sweep(dirs), dirs)
-    report["comparisons"] = [compare(cells, *spec) for spec in comparisons]
+    for directory in dirs:
+        if directory.is_dir():
+            log.info("loading %d job dirs below %s", len(find_job_dirs(directory)), directory)
+    report, cells = aggregate(load_sweep(dirs), dirs, measured)
+    report["comparisons"] = [compare(cells, *spec, measured) for spec in comparisons]
     layout = Layout(cells, report["cells"])
     notes = render_provenance(report["provenance"]) + render_problems(problem_sections(report))
     files: dict[str, str | bytes] = {
-        "table1.md": render_table_md(layout, notes),
-        "table1.csv": render_table_csv(cells, report["cells"]),
-        "table1.tex": render_table_tex(layout),
+        named("table1.md", measured): render_table_md(layout, notes, measured),
+        named("table1.csv", measured): render_table_csv(cells, report["cells"]),
+        named("table1.tex", measured): render_table_tex(layout, measured),
         "hypotheses.md": render_hypotheses(report["hypotheses"]),
+        **extra_tables(report, cells, paper),
     }
     for comparison in report["comparisons"]:
         stem = file_stem(comparison["factor"])
-        files[f"{stem}.md"] = render_compare_md(comparison)
-        files[f"{stem}.csv"] = render_compare_csv(comparison)
-    for name, fig in figures(cells).items():
+        files[named(f"{stem}.md", measured)] = render_compare_md(comparison)
+        files[named(f"{stem}.csv", measured)] = render_compare_csv(comparison)
+    log.info("drawing the figures (PNG and SVG)")
+    for name, fig in figures(cells, report["cells"], measured).items():
         for fmt in ("png", "svg"):
-            files[f"{name}.{fmt}"] = figure_bytes(fig, fmt)
-    report["outputs"] = sorted([*files, "report.json"])
-    files["report.json"] = json.dumps(report, indent=2) + "\n"
+            files[named(f"{name}.{fmt}", measured)] = figure_bytes(fig, fmt)
+    report_name = named("report.json", measured)
+    report["outputs"] = sorted([*files, report_name])
+    files[report_name] = json.dumps(report, indent=2) + "\n"
+    log.info("writing %d files into %s", len(files), out)
     try:
         out.mkdir(parents=True, exist_ok=True)
         for name, data in files.items():
@@ -236,10 +317,25 @@ def main(argv: list[str] | None = None) -> int:
         "value A in every cell, paired on common seeds; writes compare_FACTOR.md/.csv "
         "(repeatable, one per factor)",
     )
+    parser.add_argument(
+        "--metric",
+        default=TRACKING.name,
+        metavar="NAME",
+        help="the measure of result.json that the tables, CIs, figures and comparisons are of "
+        f"(default {TRACKING.name}; one of {', '.join(MEASURES)}); the files of another "
+        "measure carry its name (table1_NAME.md); the hypotheses stay on the tracking rate",
+    )
+    parser.add_argument(
+        "--paper",
+        action="store_true",
+        help="also write vs_paper.md/.csv: our tracking rate beside the paper's Table 1, "
+        "with the difference, per cell on the paper's axes",
+    )
     args = parser.parse_args(argv)
     try:
         comparisons = [parse_compare(text) for text in args.compare]
-    except CompareError as error:
+        measure(args.metric)
+    except (CompareError, MeasureError) as error:
         parser.error(str(error))
     for directory in args.sweep_dirs:
         if not directory.is_dir():
@@ -248,7 +344,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("several sweep directories need --out")
     logging.basicConfig(level=logging.INFO, format="%(levelname)s: %(message)s")
     try:
-        report = write_report(args.sweep_dirs, args.out, comparisons)
+        report = write_report(args.sweep_dirs, args.out, comparisons, args.metric, args.paper)
     except PegameError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
@@ -260,6 +356,12 @@ def main(argv: list[str] | None = None) -> int:
     )
     for warning in report["provenance"]["warnings"]:
         print(f"WARNING: {warning}")
+    if args.metric != TRACKING.name:
+        print(
+            f"tables, figures and comparisons of {args.metric} -> "
+            f"{named('table1.md', measure(args.metric))}; the hypotheses are tested on the "
+            f"tracking rate"
+        )
     for h in report["hypotheses"]:
         paired = h["summary_paired"]
         print(
@@ -270,6 +372,14 @@ def main(argv: list[str] | None = None) -> int:
         s = c["summary"]
         print(
             f"{c['factor']}: {c['b']} against {c['a']}: significant in {s['significant']} of "
-            f"{s['tested']} tested cells -> {file_stem(c['factor'])}.md"
+            f"{s['tested']} tested cells -> "
+            f"{named(file_stem(c['factor']) + '.md', measure(args.metric))}"
+        )
+    for s in report.get("vs_paper", {}).get("summaries", []):
+        where = f" ({facet_text(s['factors'])})" if s["factors"] else ""
+        print(
+            f"vs paper{where}: {s['cells']} cells, mean absolute difference "
+            f"{100 * s['mean_absolute_difference']:.1f} pp, the paper's mean inside our CI in "
+            f"{s['paper_inside_ci']} of {s['cells']} -> vs_paper.md"
         )
     return 0

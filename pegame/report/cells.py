@@ -18,9 +18,11 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
+from pegame.report.measures import is_value, values
 from pegame.report.statistics import describe
 
 MAP_ORDER = ("hall", "enclosed", "brick")
@@ -229,6 +231,10 @@ class Cell:
         """The tracking rates of its games, fractions in [0, 1]."""
         return [float(g["tracking_rate"]) for g in self.games]
 
+    def values(self, name: str) -> list[float]:
+        """The measure ``name`` of its games that define it (:mod:`~pegame.report.measures`)."""
+        return values(self.games, name)
+
     @property
     def facet(self) -> tuple:
         """The combination of the other factors (for figures and hypothesis tests)."""
@@ -259,14 +265,15 @@ class Cell:
         parts = [self.map, f"v_p/v_e {self.speed_ratio:g}", self.pairing]
         return ", ".join(parts + [f"{k}={value_text(v)}" for k, v in self.factors.items()])
 
-    def summary(self) -> dict[str, Any]:
-        """The cell for report.json: its place, factors, statistics and provenance."""
+    def summary(self, name: str = "tracking_rate") -> dict[str, Any]:
+        """The cell for report.json: its place, factors, statistics of the measure ``name``
+        and provenance."""
         return {
             "map": self.map,
             "speed_ratio": self.speed_ratio,
             "pairing": self.pairing,
             "factors": self.factors,
-            **describe(self.rates),
+            **describe(self.values(name)),
             "config_hashes": self.config_hashes(),
             "code_versions": self.code_versions(),
         }
@@ -297,6 +304,18 @@ def group_cells(games: list[dict[str, Any]], factors: list[str]) -> list[Cell]:
             pairings.index(c.pairing),
         ),
     )
+
+
+def file_safe(text: str) -> str:
+    """``text`` as a file name stem: characters unsafe in file names as '_'."""
+    return re.sub(r"[^\w.-]", "_", text)
+
+
+def numeric_factors(cells: list[Cell]) -> list[str]:
+    """The other factors whose value is a number in every cell (n_particles = 100, 500,
+    2000), in factor order: those a figure draws as a curve."""
+    factors = list(cells[0].factors) if cells else []
+    return [f for f in factors if all(is_value(c.factors[f]) for c in cells)]
 
 
 def facets(cells: list[Cell]) -> list[tuple[dict[str, Any], list[Cell]]]:

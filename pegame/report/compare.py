@@ -9,8 +9,9 @@ for two pursuers in otherwise equal cells), and compares B against A on the seed
 share (same seed, same spawn poses): n pairs, the mean of each side on those seeds, the mean difference B - A with its
 percentile-bootstrap CI over seeds, the rank-biserial correlation, and the two-sided
 Wilcoxon signed-rank test (Pratt's zeros, see :mod:`pegame.report.paired`),
-Holm-Bonferroni corrected across the comparison's tested cells. Rates are fractions in
-report.json and CSV, percent and percentage points in Markdown.
+Holm-Bonferroni corrected across the comparison's tested cells. It compares one measure
+(:mod:`pegame.report.measures`, the tracking rate by default) over the games that define
+it. Rates are fractions in report.json and CSV, percent and percentage points in Markdown.
 
 From the command line: ``python -m pegame.report DIR ... --compare FACTOR=A,B`` writes
 ``compare_<FACTOR>.md`` and ``compare_<FACTOR>.csv`` and adds the comparison to
@@ -22,14 +23,14 @@ from __future__ import annotations
 
 import csv
 import io
-import re
 from typing import Any
 
 from pegame.errors import PegameError
-from pegame.report.cells import AXES, Cell, value_text
+from pegame.report.cells import AXES, Cell, file_safe, value_text
+from pegame.report.measures import MEASURES, TRACKING, Measure
 from pegame.report.paired import TEST_NAME, by_seed, difference_text, paired_test
 from pegame.report.statistics import ALPHA, holm
-from pegame.report.tables import csv_value, percent
+from pegame.report.tables import csv_value
 
 STATS = [
     "n_a",
@@ -67,7 +68,7 @@ def parse_compare(text: str) -> tuple[str, str, str]:
 
 def file_stem(factor: str) -> str:
     """'compare_detector.miss_probability' (characters unsafe in file names as '_')."""
-    return "compare_" + re.sub(r"[^\w.-]", "_", factor)
+    return file_safe(f"compare_{factor}")
 
 
 def cell_value(cell: Cell, factor: str) -> Any:
@@ -97,9 +98,12 @@ def check(cells: list[Cell], factor: str, values: tuple[str, str]) -> None:
         raise CompareError(f"--compare {factor}: A and B are both {values[0]!r}; give two.")
 
 
-def compare(cells: list[Cell], factor: str, a: str, b: str) -> dict[str, Any]:
+def compare(
+    cells: list[Cell], factor: str, a: str, b: str, measure: Measure = TRACKING
+) -> dict[str, Any]:
     """Value ``b`` of ``factor`` against value ``a`` in every cell where both have games
-    (cells in table order): {factor, a, b, others, test, alpha, rows, summary}. A row has
+    (cells in table order), on ``measure``: {factor, a, b, measure (its name), others,
+    test, alpha, rows, summary}. A row has
     the cell's map, speed_ratio, pairing and other ``factors``, n_a / n_b (all games of
     each side), n_pairs, mean_a / mean_b on the common seeds, mean_difference (B - A) with
     ci_low / ci_high, zero_differences, rank_biserial, W, p and p_holm; every statistic is
@@ -121,7 +125,9 @@ def compare(cells: list[Cell], factor: str, a: str, b: str) -> dict[str, Any]:
         cell_b = sides[b].get(key)
         if cell_b is None:
             continue
-        test = paired_test(by_seed(cell_b.games), by_seed(cell_a.games), "two-sided")
+        test = paired_test(
+            by_seed(cell_b.games, measure.name), by_seed(cell_a.games, measure.name), "two-sided"
+        )
         axes = {axis: getattr(cell_a, axis) for axis in AXES}
         if factor in AXES:  # the compared axis: both of its values
             axes[factor] = f"{value_text(getattr(cell_a, factor))} vs {b}"
@@ -144,6 +150,7 @@ def compare(cells: list[Cell], factor: str, a: str, b: str) -> dict[str, Any]:
         "factor": factor,
         "a": a,
         "b": b,
+        "measure": measure.name,
         "difference": "B - A",
         "others": others,
         "test": f"{TEST_NAME}, two-sided, Holm-Bonferroni across the tested cells",
@@ -165,6 +172,8 @@ def number(value: float | None, spec: str) -> str:
 def render_compare_md(comparison: dict[str, Any]) -> str:
     """compare_<factor>.md: one table row per compared cell."""
     factor, a, b = comparison["factor"], comparison["a"], comparison["b"]
+    measure = MEASURES[comparison["measure"]]
+    unit = "percentage points" if measure.is_rate else measure.unit or "its own units"
     header = [
         *comparison["others"],
         "environment",
@@ -181,13 +190,14 @@ def render_compare_md(comparison: dict[str, Any]) -> str:
     ]
     summary = comparison["summary"]
     lines = [
-        f"# {factor}: {b} against {a}",
+        f"# {factor}: {b} against {a} ({measure.label})",
         "",
         "Per cell (environment x speed ratio x pairing"
         + (", and the other factors" if comparison["others"] else "")
         + f") where both {factor}={a} and {factor}={b} have games: the games on their common "
-        f"seeds (same spawn poses) are paired. Means on those seeds, the mean paired "
-        f"difference {b} - {a} in percentage points with its 95% percentile-bootstrap CI "
+        f"seeds (same spawn poses) are paired on the {measure.axis_label()}. Means on those "
+        f"seeds, the mean paired difference {b} - {a} in {unit} with its 95% "
+        f"percentile-bootstrap CI "
         f"over seeds, the matched-pairs rank-biserial correlation, and the {TEST_NAME} "
         f"(two-sided, zero_method='pratt'; W = T+, the sum of the ranks of the positive "
         f"differences), Holm-Bonferroni corrected across the "
@@ -205,9 +215,8 @@ def render_compare_md(comparison: dict[str, Any]) -> str:
             value_text(row["speed_ratio"]),
             row["pairing"],
             f"{row['n_pairs']} (of {row['n_a']}, {row['n_b']})",
-            percent(row["mean_a"]),
-            percent(row["mean_b"]),
-            difference_text(row),
+            *("–" if row[k] is None else measure.shown(row[k]) for k in ("mean_a", "mean_b")),
+            difference_text(row, measure),
             number(row["rank_biserial"], "+.2f"),
             number(row["W"], "g"),
             number(row["p"], ".3g"),

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 from scipy.stats import rankdata, wilcoxon
 
+from pegame.report.measures import TRACKING, Measure, is_value
 from pegame.report.statistics import bootstrap_ci
 
 ZERO_METHOD = "pratt"
@@ -50,15 +51,17 @@ KEYS = (
     "rank_biserial",
 )
 
-BySeed = dict[int, float]  # seed -> tracking rate (fraction)
+BySeed = dict[int, float]  # seed -> the measure (tracking rate: a fraction)
 
 
-def by_seed(games: list[dict[str, Any]]) -> BySeed:
-    """{seed: tracking rate} of a cell's games; a seed played more than once in one cell
-    (a cell mixing config hashes, which the report warns about) counts with its mean."""
+def by_seed(games: list[dict[str, Any]], name: str = "tracking_rate") -> BySeed:
+    """{seed: measure ``name``} of a cell's games that define it; a seed played more than
+    once in one cell (a cell mixing config hashes, which the report warns about) counts
+    with its mean."""
     rates: dict[int, list[float]] = {}
     for game in games:
-        rates.setdefault(int(game["seed"]), []).append(float(game["tracking_rate"]))
+        if is_value(game.get(name)):
+            rates.setdefault(int(game["seed"]), []).append(float(game[name]))
     return {seed: math.fsum(values) / len(values) for seed, values in sorted(rates.items())}
 
 
@@ -110,11 +113,14 @@ def paired_test(x: BySeed, y: BySeed, alternative: str) -> dict[str, Any]:
     }
 
 
-def difference_text(paired: dict[str, Any]) -> str:
-    """'+10.0 pp [8.2, 11.9]' for a tested comparison, '–' otherwise."""
+def difference_text(paired: dict[str, Any], measure: Measure = TRACKING) -> str:
+    """'+10.0 pp [+8.2, +11.9]' (rates; '+0.52 m [...]' for a distance) for a tested
+    comparison, '–' otherwise."""
     if paired["mean_difference"] is None:
         return "–"
-    return (
-        f"{100 * paired['mean_difference']:+.1f} pp "
-        f"[{100 * paired['ci_low']:+.1f}, {100 * paired['ci_high']:+.1f}]"
+    unit = "pp" if measure.is_rate else measure.unit
+    low, mean, high = (
+        f"{measure.scale * paired[k]:+.{measure.digits}f}"
+        for k in ("ci_low", "mean_difference", "ci_high")
     )
+    return f"{mean}{' ' + unit if unit else ''} [{low}, {high}]"

@@ -19,6 +19,7 @@ ALPHA = 0.05
 BOOT_RESAMPLES = 10_000
 BOOT_LEVEL = 0.95
 BOOT_SEED = 0
+DESCRIBED = ("n", "mean", "ci_low", "ci_high", "median", "std")  # describe()'s keys
 
 
 def bootstrap_ci(
@@ -42,7 +43,10 @@ def bootstrap_ci(
 
 
 def describe(values: list[float]) -> dict[str, Any]:
-    """n, exact mean (math.fsum, order-independent), bootstrap CI, median and sample std."""
+    """n, exact mean (math.fsum, order-independent), bootstrap CI, median and sample std;
+    n = 0 and the others None for no values."""
+    if not values:
+        return {key: 0 if key == "n" else None for key in DESCRIBED}
     low, high = bootstrap_ci(values)
     return {
         "n": len(values),

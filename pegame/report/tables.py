@@ -2,7 +2,8 @@
 Markdown, CSV and LaTeX, in the paper's layout: one row per speed ratio v_p/v_e, one column
 per environment x pairing. A sweep's other factors (see :mod:`pegame.report.cells`) come
 first, as columns of their own, so each row is one combination of them and one speed
-ratio. Rates are fractions in CSV and percentages in text. ``table1.md`` ends with the
+ratio. The table is of one measure (:mod:`pegame.report.measures`, the tracking rate by
+default); rates are fractions in CSV and percentages in text. ``table1.md`` ends with the
 provenance and with what is missing or failed.
 """
 
@@ -14,25 +15,24 @@ import re
 from typing import Any
 
 from pegame.report.cells import MAP_ORDER, PAIRING_ORDER, Cell, ordered, value_key, value_text
-from pegame.report.statistics import BOOT_LEVEL, BOOT_RESAMPLES
+from pegame.report.measures import TRACKING, Measure
+from pegame.report.statistics import BOOT_LEVEL, BOOT_RESAMPLES, DESCRIBED
 
 MAP_TITLES = {"hall": "Complex Hall", "enclosed": "Enclosed Room", "brick": "Brick Room"}
-STATS = ["n", "mean", "ci_low", "ci_high", "median", "std"]
 
 
-def percent(value: float | None, digits: int = 1) -> str:
-    """A fraction as a percentage string, '–' for None."""
-    return "–" if value is None else f"{100 * value:.{digits}f}%"
+def interval_text(cell: dict[str, Any], measure: Measure) -> str:
+    """'[55.0, 67.2]': a described cell's CI in the measure's shown unit."""
+    low, high = (f"{measure.scale * cell[k]:.{measure.digits}f}" for k in ("ci_low", "ci_high"))
+    return f"[{low}, {high}]"
 
 
-def cell_text(cell: dict[str, Any] | None) -> str:
-    """'61.3% [55.0, 67.2] n=40' for a described cell, '–' for none."""
-    if cell is None:
+def cell_text(cell: dict[str, Any] | None, measure: Measure = TRACKING) -> str:
+    """'61.3% [55.0, 67.2] n=40' for a described cell, '–' for none or no games that
+    define the measure."""
+    if cell is None or not cell["n"]:
         return "–"
-    return (
-        f"{percent(cell['mean'])} [{100 * cell['ci_low']:.1f}, {100 * cell['ci_high']:.1f}] "
-        f"n={cell['n']}"
-    )
+    return f"{measure.shown(cell['mean'])} {interval_text(cell, measure)} n={cell['n']}"
 
 
 class Layout:
@@ -59,19 +59,22 @@ class Layout:
         return [value_text(v) for v in self.row_factors[row].values()]
 
 
-def render_table_md(layout: Layout, notes: list[str]) -> str:
-    """Table 1 in Markdown, then ``notes`` (the provenance and problem sections)."""
+def render_table_md(layout: Layout, notes: list[str], measure: Measure = TRACKING) -> str:
+    """Table 1 of ``measure`` in Markdown, then ``notes`` (the provenance and problem
+    sections)."""
     header = (
         layout.factors + ["v_p/v_e"] + [f"{m} {p}" for m in layout.maps for p in layout.pairings]
     )
     lines = [
-        "# Table 1: mean tracking success rate",
+        f"# Table 1: mean {measure.label}",
         "",
-        f"Mean tracking success rate per environment, pursuer-to-evader speed ratio v_p/v_e and "
+        f"Mean {measure.axis_label()} per environment, pursuer-to-evader speed ratio v_p/v_e and "
         f"pairing (R-R: random pursuer, random evader; S-R: smart pursuer, random evader; S-S: "
         f"smart pursuer, smart evader), with its {100 * BOOT_LEVEL:.0f}% percentile-bootstrap "
-        f"confidence interval ({BOOT_RESAMPLES:,} resamples) and the number of games n. Layout "
-        f"of the paper's Table 1"
+        f"confidence interval ({BOOT_RESAMPLES:,} resamples) and the number of games n"
+        + ("" if measure is TRACKING else " that define it")
+        + ". Layout "
+        "of the paper's Table 1"
         + (
             "; the columns before v_p/v_e are the settings that differ between the sweep's "
             "configurations."
@@ -86,7 +89,7 @@ def render_table_md(layout: Layout, notes: list[str]) -> str:
         texts = (
             layout.factor_texts(row)
             + [f"{row[1]:g}"]
-            + [cell_text(c) for c in layout.row_cells(row)]
+            + [cell_text(c, measure) for c in layout.row_cells(row)]
         )
         lines.append("| " + " | ".join(texts) + " |")
     return "\n".join(lines + [""] + notes) + "\n"
@@ -109,7 +112,7 @@ def render_table_csv(cells: list[Cell], described: list[dict[str, Any]]) -> str:
     factors = list(cells[0].factors) if cells else []
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(["map", "speed_ratio", "pairing", *factors, *STATS])
+    writer.writerow(["map", "speed_ratio", "pairing", *factors, *DESCRIBED])
     for cell, stats in zip(cells, described):
         writer.writerow(
             [
@@ -117,7 +120,7 @@ def render_table_csv(cells: list[Cell], described: list[dict[str, Any]]) -> str:
                 cell.speed_ratio,
                 cell.pairing,
                 *(csv_value(v) for v in cell.factors.values()),
-                *("" if stats[s] is None else stats[s] for s in STATS),
+                *("" if stats[s] is None else stats[s] for s in DESCRIBED),
             ]
         )
     return buffer.getvalue()
@@ -128,18 +131,19 @@ def tex_escape(text: str) -> str:
     return re.sub(r"([&%$#_{}])", r"\\\1", text)
 
 
-def tex_cell(cell: dict[str, Any] | None) -> str:
+def tex_cell(cell: dict[str, Any] | None, measure: Measure = TRACKING) -> str:
     """A table cell in LaTeX: mean, then CI and n in small type."""
-    if cell is None:
+    if cell is None or not cell["n"]:
         return "--"
     return (
-        f"{100 * cell['mean']:.1f}\\% {{\\scriptsize [{100 * cell['ci_low']:.1f}, "
-        f"{100 * cell['ci_high']:.1f}] $n$={cell['n']}}}"
+        f"{tex_escape(measure.shown(cell['mean']))} {{\\scriptsize "
+        f"{interval_text(cell, measure)} $n$={cell['n']}}}"
     )
 
 
-def render_table_tex(layout: Layout) -> str:
-    """Table 1 as a booktabs tabular in the paper's layout (other factors leftmost)."""
+def render_table_tex(layout: Layout, measure: Measure = TRACKING) -> str:
+    """Table 1 of ``measure`` as a booktabs tabular in the paper's layout (other factors
+    leftmost)."""
     maps, width, lead = layout.maps, len(layout.pairings), len(layout.factors) + 1
     groups = " & ".join(
         f"\\multicolumn{{{width}}}{{c}}{{\\textbf{{{tex_escape(MAP_TITLES.get(m, m))}}}}}"
@@ -151,8 +155,8 @@ def render_table_tex(layout: Layout) -> str:
     )
     names = [f"\\texttt{{{tex_escape(f)}}}" for f in layout.factors]
     lines = [
-        "% Generated by pegame.report: mean tracking success rate, 95% bootstrap CI and n per cell"
-        " (paper, Table 1). Needs \\usepackage{booktabs}.",
+        f"% Generated by pegame.report: mean {measure.axis_label()}, 95% bootstrap CI and n per "
+        "cell (paper, Table 1). Needs \\usepackage{booktabs}.",
         "\\begin{tabular}{" + "l" * lead + (" " + "c" * width) * len(maps) + "}",
         "\\toprule",
         " & ".join(["" for _ in names] + ["\\textbf{Speed ratio}"] + ([groups] if maps else []))
@@ -164,7 +168,9 @@ def render_table_tex(layout: Layout) -> str:
     ]
     for row in layout.rows:
         texts = [tex_escape(t) for t in layout.factor_texts(row)] + [f"{row[1]:g}"]
-        lines.append(" & ".join(texts + [tex_cell(c) for c in layout.row_cells(row)]) + " \\\\")
+        lines.append(
+            " & ".join(texts + [tex_cell(c, measure) for c in layout.row_cells(row)]) + " \\\\"
+        )
     return "\n".join(lines + ["\\bottomrule", "\\end{tabular}"]) + "\n"
 
 

@@ -76,10 +76,10 @@ def test_a_sweep_over_the_estimator_is_reported_and_tested_per_estimator(tmp_pat
     md = (tmp_path / "hypotheses.md").read_text()
     assert "## H1 (estimator.name=last_seen): holds (in 1 of 1 cells)" in md
     from pegame.report.cells import group_cells, other_factors, select
-    from pegame.report.figures import figures
+    from pegame.report.figures import box_figures
 
     games = select(report.load_sweep(tmp_path).records).games
-    panels = figures(group_cells(games, other_factors(games)))["fig5a_speed_ratio"].axes
+    panels = box_figures(group_cells(games, other_factors(games)))["fig5a_speed_ratio"].axes
     assert sorted(ax.get_title() for ax in panels) == [
         "estimator.name=last_seen",
         "estimator.name=particle_filter",
