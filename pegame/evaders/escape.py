@@ -45,6 +45,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 from scipy.ndimage import distance_transform_edt
 
 from pegame.grid import OccupancyGrid, per_grid
@@ -219,7 +220,14 @@ class Costs(NamedTuple):
 
 
 @njit(cache=True)
-def _best_candidate(tiles, bounds, cells, exposed, costs, best):
+def _best_candidate(
+    tiles: np.ndarray,
+    bounds: np.ndarray,
+    cells: TiledCells,
+    exposed: Window,
+    costs: Costs,
+    best: tuple[int, float],
+) -> tuple[int, float, bool]:
     """Algorithm 2's argmin over the ``cells`` of ``tiles`` outside the ``exposed`` window
     and the ``best`` (flat cell, cost) found before them ((-1, inf) for none): (flat cell,
     cost, stopped), stopped when a tile's bound ended the search before the last tile.
@@ -461,7 +469,7 @@ class EscapeSearch:
             raise ValueError("Geodesic distances need the pursuer's planner (pursuer_planner).")
         return self.pursuer_planner.distance_field((pursuer.x, pursuer.y)).ravel()
 
-    def centres(self, cells) -> np.ndarray:
+    def centres(self, cells: ArrayLike) -> np.ndarray:
         """Float (..., 2): the map-frame centres (m) of flat row-major cell indices (an
         index or an array of them), as :meth:`OccupancyGrid.cell_to_world` gives them."""
         cells = np.asarray(cells, dtype=np.int64)
@@ -506,7 +514,9 @@ class EscapeSearch:
             return np.zeros((0, 0), dtype=bool), 0, 0
         return _grow(visible.mask, r0, r1, c0, c1, self._half_widths)
 
-    def _bounds(self, component: _Component, me: Pose, pursuer: Pose):
+    def _bounds(
+        self, component: _Component, me: Pose, pursuer: Pose
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per-tile cost lower bounds (T,) and, for geodesic distances, the flat effort and
         dist fields (m) (empty arrays for Euclidean ones)."""
         if self.distance == "euclidean":

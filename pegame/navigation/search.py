@@ -123,7 +123,9 @@ def allowed_moves(traversable: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def dijkstra(lattice, weighted, source, pool):
+def dijkstra(
+    lattice: Lattice, weighted: bool, source: int, pool: BucketPool
+) -> tuple[np.ndarray, bool]:
     """Least path cost (m) over ``lattice`` from flat cell ``source`` to every cell, inf if
     unreachable; each step's length times its cells' mean multiplier when ``weighted``.
 
@@ -256,7 +258,9 @@ def _octile(resolution, row, col, goal_row, goal_col):
 
 
 @njit(cache=True)
-def astar(lattice, start, goal, heuristic, scratch):
+def astar(
+    lattice: Lattice, start: int, goal: int, heuristic: Heuristic, scratch: AStarScratch
+) -> tuple[float, np.ndarray, int]:
     """Minimum weighted cost (m), flat cell path and number of cells reached over
     ``lattice`` from flat cell ``start`` to ``goal`` by A*.
 

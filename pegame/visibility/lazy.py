@@ -30,6 +30,9 @@ from pegame.types import Camera, Pose
 from pegame.visibility.rays import directions, ray_tables
 from pegame.visibility.region import MaskRegion, lookup, march, whole_region
 
+#: a block of cells: (first row, last row, first column, last column), inclusive
+Block = tuple[int, int, int, int]
+
 
 class Sight(NamedTuple):
     """The grid as the ray kernels see it."""
@@ -137,7 +140,7 @@ class VisibilityRegion:
 
 
 @njit(cache=True)
-def _mask_over(sight, eye, rays, block):
+def _mask_over(sight: tuple, eye: tuple, rays: tuple, block: Block) -> np.ndarray:
     """Kernel of :meth:`VisibilityRegion.mask_over`: march the rays reaching the block
     (row0, row1, col0, col1) of cells."""
     blocked, frame, yaw = sight
@@ -152,7 +155,7 @@ def _mask_over(sight, eye, rays, block):
 
 
 @njit(cache=True)
-def _holds(cells, sight, eye, rays):
+def _holds(cells: np.ndarray, sight: tuple, eye: tuple, rays: tuple) -> np.ndarray:
     """Kernel of :meth:`VisibilityRegion.holds` for a region not yet computed whole."""
     blocked, frame, yaw = sight
     _, _, _, _, _, fov, far = rays
@@ -172,7 +175,9 @@ def _in_cells(x, y, ox, oy, yaw, resolution):
 
 
 @njit(cache=True)
-def _near_wedge(cells, width, eye, frame, yaw, fov, far):
+def _near_wedge(
+    cells: np.ndarray, width: int, eye: tuple, frame: tuple, yaw: float, fov: float, far: float
+) -> tuple[np.ndarray, Block]:
     """(near (N,) bool, (row min, row max, col min, col max) of the near cells): which flat
     cell indices (negative: none) of a grid ``width`` cells wide (``frame``, rotated by
     ``yaw``) have their centre within half a cell diagonal (plus a rounding margin) of the
@@ -217,7 +222,9 @@ _REACH_MARGIN = 0.5
 
 
 @njit(cache=True)
-def _rays_reaching(rays, eye, frame, yaw, block):
+def _rays_reaching(
+    rays: tuple, eye: tuple, frame: tuple, yaw: float, block: Block
+) -> tuple[int, int, int]:
     """(first ray, stop ray, samples): the ``rays`` angles[first:stop] (rad from the
     ``eye``'s heading theta) and the number of samples along each (from the first) that
     can land in the block of cells row0..row1 x col0..col1 (inclusive) of a grid
