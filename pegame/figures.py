@@ -153,3 +153,38 @@ def _title(map_name: str, pairing: str | None, tracking_rate: float | None) -> s
     if tracking_rate is not None:
         title += f": tracking rate {100 * tracking_rate:.1f}%"
     return title
+
+
+def plot_time_series(
+    time: np.ndarray,
+    series: Sequence[tuple[str, str, np.ndarray]],
+    path: str | Path,
+    *,
+    title: str = "",
+) -> Path:
+    """One panel per series against simulated time (s), sharing the time axis, written as a
+    PNG to ``path`` atomically. series: (label with its unit, colour, (T,) values; NaN
+    where a tick has none: the panel says "not recorded" when all are NaN). Returns
+    ``path``."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(8.0, 1.6 * len(series) + 0.8), dpi=110)
+    FigureCanvasAgg(figure)
+    panels = figure.subplots(len(series), 1, sharex=True, squeeze=False)[:, 0]
+    for axes, (label, color, values) in zip(panels, series):
+        values = np.asarray(values, dtype=float)
+        if np.isfinite(values).any():
+            axes.plot(time, values, color=color, linewidth=1.2, drawstyle="steps-post")
+        else:
+            axes.text(0.5, 0.5, "not recorded", ha="center", va="center", transform=axes.transAxes)
+        axes.set_ylabel(label, fontsize=9)
+        axes.grid(alpha=0.3)
+    panels[-1].set_xlabel("time (s)")
+    if title:
+        panels[0].set_title(textwrap.fill(title, 90), fontsize=10)
+    figure.tight_layout()
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png")
+    write_atomic(path, buffer.getvalue())
+    return Path(path)

@@ -1,4 +1,6 @@
-"""Open a run's Rerun recordings: ``python -m pegame.replay <run dir> [--list]``.
+"""Open a run's Rerun recordings: ``python -m pegame.replay <run dir> [--list]``, or
+draw a game headless: ``--video out.mp4``, ``--png out.png [--at SECONDS]``, ``--series
+out.png`` (:mod:`pegame.movie`).
 
 Finds every recording under the run directory, recursively (a sweep keeps one directory
 per job), sorted by path: ``<game_id>.rrd`` (complete), ``<game_id>.failed.rrd`` (the
@@ -9,6 +11,12 @@ path, size and status. The viewer is the ``rerun`` CLI of the rerun-sdk installe
 this Python (``python -m rerun``), so it always reads the recordings' format version.
 Partial files are listed but not opened: the viewer only loads ``*.rrd`` files, and one
 may still be being written; copy one to a ``.rrd`` name to look at it.
+
+The headless outputs need no display: they draw one game (the run's only recording, or
+the one ``--game`` names: a part of its path that no other recording's path has; a run
+recorded with ``recorder=none`` is drawn from its ``trajectory.csv``). On a remote machine
+the viewer itself can also be served to a browser: ``python -m rerun --serve-web
+<file.rrd>`` and open the printed address (forward the port over ssh).
 """
 
 from __future__ import annotations
@@ -59,6 +67,51 @@ def human_size(size: int) -> str:
     return f"{size / 1e6:.1f} MB"
 
 
+def game_source(run_dir: str | Path, game: str | None) -> Path:
+    """The recording (or, without one, the job directory with ``trajectory.csv``) that the
+    headless outputs draw: the run's only readable recording, or the one whose path holds
+    ``game``. ReplayError naming the candidates when that is not exactly one."""
+    root = Path(run_dir).expanduser()
+    if root.is_file():
+        return root
+    try:
+        files = [p for p in find_recordings(root) if recording_status(p) != PARTIAL]
+    except ReplayError:
+        if (root / "trajectory.csv").is_file() and game is None:
+            return root
+        raise
+    chosen = [p for p in files if game is None or game in str(p.relative_to(root))]
+    if len(chosen) == 1:
+        return chosen[0]
+    names = ", ".join(str(p.relative_to(root)) for p in (chosen or files)[:8])
+    more = " ..." if len(chosen or files) > 8 else ""
+    what = f"match --game {game!r}" if game is not None else "are recorded here"
+    raise ReplayError(
+        f"{len(chosen)} games {what}; name one with --game (a part of its path): {names}{more}"
+    )
+
+
+def draw(args: argparse.Namespace) -> int:
+    """Write the headless outputs the arguments ask for (:mod:`pegame.movie`)."""
+    from pegame.movie import MovieError, load_game, write_png, write_series, write_video
+
+    try:
+        source = game_source(args.run_dir, args.game)
+        game = load_game(source)
+        if args.size < 16:
+            raise ReplayError(f"--size must be at least 16 pixels, not {args.size}")
+        if args.video:
+            print(f"pegame.replay: {write_video(game, args.video, args.size, args.speed)}")
+        if args.png:
+            print(f"pegame.replay: {write_png(game, args.png, args.at, args.size)}")
+        if args.series:
+            print(f"pegame.replay: {write_series(game, args.series, title=str(source))}")
+    except (ReplayError, MovieError) as exc:
+        print(f"pegame.replay: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Command-line entry point; returns the exit status (2 when there is nothing to replay)."""
     parser = argparse.ArgumentParser(
@@ -73,7 +126,28 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="list the recordings, their sizes and statuses (complete, failed, partial) instead",
     )
+    parser.add_argument("--video", metavar="OUT.mp4", help="write the game as an MP4 video")
+    parser.add_argument("--png", metavar="OUT.png", help="write one frame (see --at) as a PNG")
+    parser.add_argument(
+        "--series",
+        metavar="OUT.png",
+        help="write the game's detection, distance, estimation error and N_eff against time",
+    )
+    parser.add_argument(
+        "--at", type=float, metavar="SECONDS", help="the --png frame's time (default: the last)"
+    )
+    parser.add_argument(
+        "--game", help="which game of the run to draw: a part of its recording's path"
+    )
+    parser.add_argument(
+        "--speed", type=float, default=1.0, help="video pace, times the game's (default 1)"
+    )
+    parser.add_argument(
+        "--size", type=int, default=480, help="frame's longer side in pixels (default 480)"
+    )
     args = parser.parse_args(argv)
+    if args.video or args.png or args.series:
+        return draw(args)
     try:
         files = find_recordings(args.run_dir)
     except ReplayError as exc:

@@ -22,7 +22,7 @@ after every step; and at the end ``metrics``, the game's
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import overload
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 from omegaconf import DictConfig
@@ -30,8 +30,25 @@ from omegaconf import DictConfig
 from pegame.envs.actions import to_velocity
 from pegame.envs.observations import EvaderFeatures, PursuerFeatures
 from pegame.envs.settings import EnvSettings
+from pegame.errors import ConfigError
 from pegame.game import Scenario
 from pegame.loop import TickLoop, nearest
+
+if TYPE_CHECKING:  # pragma: no cover - typing only
+    from pegame.render import FrameRenderer
+
+#: the render modes of the environments: ``rgb_array``, a frame from above (EnvGame.frame)
+RENDER_MODES = ("rgb_array",)
+
+
+def check_render_mode(mode: str | None) -> str | None:
+    """``mode`` if it is None or one of :data:`RENDER_MODES`, else a ConfigError."""
+    if mode is not None and mode not in RENDER_MODES:
+        raise ConfigError(
+            f"Invalid value for 'render_mode': {mode!r}. Allowed: None or "
+            f"{', '.join(repr(m) for m in RENDER_MODES)} (a frame from above as an RGB array)."
+        )
+    return mode
 
 
 @overload
@@ -117,6 +134,12 @@ class EnvGame:
         self.evader_detections = [0] * sizes["evader"]  # in the last step, per evader
         self.seed: int | None = None
         self.loop: TickLoop | None = None
+        self._renderer: tuple[int, FrameRenderer] | None = None  # (size, renderer) of frame()
+
+    @property
+    def step_period(self) -> float:
+        """Simulated time of one env step (s): the ticks of one action."""
+        return self.ticks_per_action * self.scenario.context.control_dt
 
     @property
     def steps(self) -> int:
@@ -212,6 +235,56 @@ class EnvGame:
                 velocities.append(to_velocity(actions[agent], body, clip, who))
             commands[role] = velocities[0] if len(velocities) == 1 else velocities
         return commands
+
+    def frame(self, size: int = 480) -> np.ndarray:
+        """The current tick drawn from above (:mod:`pegame.render`): the map, every
+        pursuer's visibility region (green while it detects its target evader), the belief
+        about evader 0 (its particles, at most 500, and its mean), every body; (H, W, 3)
+        uint8, the longer side ``size`` px. A blank map before the first reset."""
+        from pegame.recorders.rerun import RerunRecorder
+        from pegame.render import FrameRenderer, FrameState
+        from pegame.visibility.outlines import visibility_outlines
+
+        context = self.scenario.context
+        if self._renderer is None or self._renderer[0] != size:
+            camera = context.camera
+            self._renderer = (
+                size,
+                FrameRenderer(
+                    context.grid,
+                    fov=camera.fov,
+                    near=camera.near,
+                    far=camera.far,
+                    pursuer_radius=context.pursuer.radius,
+                    evader_radius=context.evader.radius,
+                    size=size,
+                ),
+            )
+        renderer, loop = self._renderer[1], self.loop
+        if loop is None:
+            return renderer.frame(FrameState(np.empty((0, 3)), np.empty((0, 3)), []))
+        pursuers = np.array([(p.x, p.y, p.theta) for p in loop.pursuers])
+        outlines = visibility_outlines(
+            context.grid,
+            pursuers[:, 0],
+            pursuers[:, 1],
+            pursuers[:, 2],
+            context.camera,
+            RerunRecorder.Config.outline_rays,
+        )
+        n_evaders = len(loop.evaders)
+        belief = loop.beliefs[0]
+        particles = belief.particles[:500, :2] if belief.particles is not None else np.empty((0, 2))
+        state = FrameState(
+            pursuers,
+            np.array([(e.x, e.y, e.theta) for e in loop.evaders]),
+            [loop.detections[i][i % n_evaders] is not None for i in range(len(pursuers))],
+            [[outline[:, :2].astype(float)] for outline in outlines],
+            particles,
+            np.asarray(belief.mean, dtype=float) if belief.mean is not None else None,
+            loop.time,
+        )
+        return renderer.frame(state)
 
     def close(self) -> None:
         """Release the current game's simulator."""

@@ -20,7 +20,7 @@ from gymnasium import spaces
 from omegaconf import DictConfig
 from pettingzoo import ParallelEnv
 
-from pegame.envs.core import EnvGame, check_seed, game_seed
+from pegame.envs.core import RENDER_MODES, EnvGame, check_render_mode, check_seed, game_seed
 from pegame.envs.settings import env_config, env_settings
 from pegame.loop import ROLES
 
@@ -33,16 +33,23 @@ class PursuitEvasionParallelEnv(ParallelEnv):
     ``["env=hall", "game.t_max=30"]``). The ``pursuer`` and ``evader`` nodes give the
     bodies only; the config's ``game.seed`` is not used: seed with ``reset(seed=...)``.
     settings: :class:`pegame.envs.settings.EnvSettings` fields (decision_period,
-    crop_cells, crop_resolution, belief, clip_actions).
+    crop_cells, crop_resolution, belief, clip_actions). render_mode: None or
+    ``"rgb_array"`` (``render()`` draws the game from above, :meth:`EnvGame.frame`).
     """
 
-    metadata = {"name": "pegame_pursuit_evasion_v0", "render_modes": []}
+    metadata = {"name": "pegame_pursuit_evasion_v0", "render_modes": list(RENDER_MODES)}
 
     def __init__(
-        self, config: DictConfig | None = None, overrides: Sequence[str] = (), **settings
+        self,
+        config: DictConfig | None = None,
+        overrides: Sequence[str] = (),
+        render_mode: str | None = None,
+        **settings,
     ) -> None:
         self.settings = env_settings(**settings)
+        self.render_mode = check_render_mode(render_mode)
         self.game = EnvGame(env_config(config, overrides), self.settings, ROLES)
+        self.metadata = {**self.metadata, "render_fps": 1.0 / self.game.step_period}
         self.possible_agents = list(self.game.agents)
         self.agents: list[str] = []
         features = self.game.features
@@ -84,12 +91,19 @@ class PursuitEvasionParallelEnv(ParallelEnv):
             self.agents = []
         return obs, rewards, dict.fromkeys(agents, False), dict.fromkeys(agents, done), infos
 
+    def render(self) -> np.ndarray | None:
+        """The current tick as an (H, W, 3) uint8 image in ``rgb_array`` mode, else None."""
+        return self.game.frame() if self.render_mode == "rgb_array" else None
+
     def close(self) -> None:
         self.game.close()
 
 
 def parallel_env(
-    config: DictConfig | None = None, overrides: Sequence[str] = (), **settings
+    config: DictConfig | None = None,
+    overrides: Sequence[str] = (),
+    render_mode: str | None = None,
+    **settings,
 ) -> PursuitEvasionParallelEnv:
     """The PettingZoo Parallel environment (see :class:`PursuitEvasionParallelEnv`)."""
-    return PursuitEvasionParallelEnv(config, overrides, **settings)
+    return PursuitEvasionParallelEnv(config, overrides, render_mode, **settings)

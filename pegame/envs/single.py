@@ -17,7 +17,7 @@ import numpy as np
 from gymnasium import spaces
 from omegaconf import DictConfig
 
-from pegame.envs.core import EnvGame, check_seed, game_seed
+from pegame.envs.core import RENDER_MODES, EnvGame, check_render_mode, check_seed, game_seed
 from pegame.envs.settings import env_config, env_settings
 from pegame.errors import ConfigError
 
@@ -33,24 +33,29 @@ class _SingleAgentEnv(gymnasium.Env):
     registry name of the other role's strategy (``smart``, ``random`` or any registered
     plugin); None keeps the config's choice (``smart`` by default); with overrides it
     adds ``<role>=<opponent>``, with a config it must match it. The config's ``game.seed``
-    is not used: seed with ``reset(seed=...)``. settings: :class:`EnvSettings` fields.
+    is not used: seed with ``reset(seed=...)``. render_mode: None or ``"rgb_array"``
+    (``render()`` draws the game from above, :meth:`EnvGame.frame`). settings:
+    :class:`EnvSettings` fields.
     """
 
     role: ClassVar[str]
     env_id: ClassVar[str]
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": list(RENDER_MODES)}
 
     def __init__(
         self,
         config: DictConfig | None = None,
         overrides: Sequence[str] = (),
         opponent: str | None = None,
+        render_mode: str | None = None,
         **settings,
     ) -> None:
         self.settings = env_settings(**settings)
+        self.render_mode = check_render_mode(render_mode)
         other = "evader" if self.role == "pursuer" else "pursuer"
         cfg = env_config(config, overrides, {other: opponent} if opponent is not None else None)
         self.game = EnvGame(cfg, self.settings, (self.role,))
+        self.metadata = {**self.metadata, "render_fps": 1.0 / self.game.step_period}
         for key, size in zip(("team.pursuers", "team.evaders"), self.game.scenario.team_size):
             if size != 1:
                 raise ConfigError(
@@ -76,6 +81,10 @@ class _SingleAgentEnv(gymnasium.Env):
         """One decision period (ValueError for a bad action)."""
         obs, reward, done = self.game.step({self.role: action})
         return obs[self.role], self._sign * reward, False, done, self.game.info()
+
+    def render(self) -> np.ndarray | None:
+        """The current tick as an (H, W, 3) uint8 image in ``rgb_array`` mode, else None."""
+        return self.game.frame() if self.render_mode == "rgb_array" else None
 
     def close(self) -> None:
         self.game.close()
