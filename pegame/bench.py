@@ -33,7 +33,7 @@ from pegame.config import compose, resolve_map_path
 from pegame.game import Game
 from pegame.grid import OccupancyGrid, load_map
 from pegame.navigation import Planner
-from pegame.types import Body, Camera, Pose
+from pegame.types import Belief, Body, Camera, Plan, Pose
 from pegame.visibility import MaskRegion, VisibilityRegion, visibility_region
 
 PAPER_MAPS = ("hall", "enclosed", "brick")
@@ -169,7 +169,7 @@ def bench_decisions(
         masks = [MaskRegion(visibility_region(grid, p, camera)) for p, _ in pairs]
         it = iter(list(zip(pairs, masks)) * 2)
 
-        def pf_step():
+        def pf_step() -> Belief:
             (p, _), mask = next(it)
             return pf.update(0.1, p, None, mask)
 
@@ -182,7 +182,7 @@ def bench_decisions(
             pursuer.reset(p0)
             it2 = iter(list(zip(pairs, masks)) * 2)
 
-            def pursuer_decision():
+            def pursuer_decision() -> Plan:
                 (p, _), mask = next(it2)
                 belief = pf.update(0.1, p, None, mask)
                 return pursuer.decide(PursuerObservation(0.0, p, None, belief, mask))
@@ -194,7 +194,7 @@ def bench_decisions(
         evader.reset(pairs[0][1])
         it3 = iter(pairs * 2)
 
-        def evader_decision():
+        def evader_decision() -> Plan:
             p, e = next(it3)
             return evader.decide(EvaderObservation(0.0, e, p))
 

@@ -40,13 +40,18 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from pegame.config import resolve_map_path
 from pegame.grid import OccupancyGrid, load_map, save_map
+
+if TYPE_CHECKING:  # pragma: no cover - typing only (the module imports them where used)
+    from pegame.types import Pose, Region
+    from pegame.visibility import MaskRegion
 
 #: map sizes (cells a side) of the scaling table
 SIZES = (400, 1000, 2000, 4000)
@@ -100,7 +105,7 @@ class _Players:
         )
         self.pursuer = pursuer(registry.make_config("pursuer", pursuer, {}), self.context, rngs[2])
 
-    def start(self):
+    def start(self) -> tuple[Pose, Pose, MaskRegion]:
         """A game-like start (pursuer pose, evader pose, the pursuer's region)."""
         from pegame.game import spawn
         from pegame.visibility import MaskRegion, visibility_region
@@ -108,13 +113,13 @@ class _Players:
         p, e = spawn(self.context, self.rng)
         return p, e, MaskRegion(visibility_region(self.grid, p, self.camera))
 
-    def evader_decision(self, p, e) -> None:
+    def evader_decision(self, p: Pose, e: Pose) -> None:
         from pegame.api import EvaderObservation
 
         self.evader.reset(e)
         self.evader.decide(EvaderObservation(0.0, e, p))
 
-    def pursuer_decision(self, p, region) -> None:
+    def pursuer_decision(self, p: Pose, region: Region) -> None:
         """The estimator's update and the pursuer's plan to the estimate; the estimator is
         reset beforehand (not timed) over the region, as just after the evader left it."""
         from pegame.api import PursuerObservation
@@ -182,7 +187,7 @@ def measure_game(yaml_path: str, out_dir: str) -> tuple[float, float, float]:
 
 
 def map_scaling(
-    sizes=SIZES, repeat: int = 10, game: bool = True, source: str = SOURCE_MAP
+    sizes: Sequence[int] = SIZES, repeat: int = 10, game: bool = True, source: str = SOURCE_MAP
 ) -> list[dict[str, Any]]:
     """One row per map size (module docstring) on ``source`` scaled up; ``game=False``
     skips the CLI games."""
@@ -200,7 +205,7 @@ def map_scaling(
     return rows
 
 
-def _fmt(value) -> str:
+def _fmt(value: float | None) -> str:
     return "-" if value is None else f"{value:.2f}" if value < 100 else f"{value:.0f}"
 
 

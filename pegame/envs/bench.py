@@ -8,12 +8,16 @@ import os
 import statistics
 import time
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 
 def bench_steps_per_second(
-    seconds: float = 5.0, overrides: Sequence[str] = ("env=enclosed",), seed: int = 0, **settings
+    seconds: float = 5.0,
+    overrides: Sequence[str] = ("env=enclosed",),
+    seed: int = 0,
+    **settings: Any,
 ) -> dict[str, float]:
     """Run the two-agent env with uniformly random actions for about ``seconds`` s of
     wall time on one core (default options, a paper map) and measure it.
@@ -88,7 +92,7 @@ def bench_vector_env(
     overrides: Sequence[str] = ("env=enclosed",),
     seed: int = 0,
     single_steps: int = 300,
-    **settings,
+    **settings: Any,
 ) -> dict[str, float | int]:
     """The batched env (:mod:`pegame.envs.vector`) against the single env, in the same run.
 

@@ -7,6 +7,7 @@ import difflib
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
+from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
@@ -55,7 +56,7 @@ class EnvSettings(ObservationSettings):
         return ticks
 
 
-def env_settings(**options) -> EnvSettings:
+def env_settings(**options: Any) -> EnvSettings:
     """Validated :class:`EnvSettings`; an unknown option is a ConfigError that lists the
     allowed ones (and the closest match)."""
     allowed = [f.name for f in fields(EnvSettings)]

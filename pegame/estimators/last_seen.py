@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pegame.api import Estimator
-from pegame.types import EMPTY_BELIEF, Belief
+from pegame.types import EMPTY_BELIEF, Belief, Detection, Pose, Region
 
 
 class LastSeen(Estimator):
@@ -11,11 +11,13 @@ class LastSeen(Estimator):
 
     description = "Baseline: the evader's last detected map position."
 
-    def reset(self, pursuer, detection, visible) -> Belief:
+    def reset(self, pursuer: Pose, detection: Detection | None, visible: Region) -> Belief:
         self.belief = EMPTY_BELIEF
         return self.update(0.0, pursuer, detection, visible)
 
-    def update(self, dt, pursuer, detection, visible) -> Belief:
+    def update(
+        self, dt: float, pursuer: Pose, detection: Detection | None, visible: Region
+    ) -> Belief:
         if detection is not None:
             self.belief = Belief(mean=detection.position)
         return self.belief

@@ -63,7 +63,7 @@ import numpy as np
 from numba import njit
 from scipy.ndimage import distance_transform_edt
 
-from pegame.api import Estimator
+from pegame.api import Context, Estimator
 from pegame.errors import MapError, require
 from pegame.estimators.resampling import RESAMPLERS, ThresholdResampler, effective_sample_size
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
@@ -249,7 +249,7 @@ class ParticleFilter(Estimator):
                 value = getattr(self, name)
                 require(math.isfinite(value), name, "a finite number", value)
 
-    def __init__(self, config: Config, context, rng: np.random.Generator) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         grid = context.grid
         self._blocked = grid.blocked.ravel()
@@ -328,7 +328,9 @@ class ParticleFilter(Estimator):
 
     # ------------------------------------------------------------------ models
 
-    def _weigh(self, dt, detection, visible):
+    def _weigh(
+        self, dt: float, detection: Detection | None, visible: Region
+    ) -> tuple[np.ndarray, np.ndarray, float, float, float]:
         """Draw the motion and return the moved particles (N, 3), their weights (N,)
         normalised when their sum ``total`` is positive and finite, ``total``, the
         detection's evidence sum_i w_i L_i (0 without one) and N_eff (0 when not
@@ -360,7 +362,9 @@ class ParticleFilter(Estimator):
         )
         return moved, weights, total, evidence, n_eff
 
-    def _weigh_reference(self, dt, detection, visible):
+    def _weigh_reference(
+        self, dt: float, detection: Detection | None, visible: Region
+    ) -> tuple[np.ndarray, np.ndarray, float, float, float]:
         """Plain numpy :meth:`_weigh`."""
         cfg = self.config
         unit_speeds, normals = self._draw()

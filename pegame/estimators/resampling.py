@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
@@ -45,6 +46,10 @@ from numba import njit
 def effective_sample_size(weights: np.ndarray) -> float:
     """N_eff = 1 / sum(w^2) of normalised weights (N,) (the paper's Eq.)."""
     return 1.0 / float(np.dot(weights, weights))
+
+
+#: maps positions in [0, 1) to the indices of the cumulative weights holding them
+Invert = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
 class Resampler(ABC):
@@ -64,7 +69,7 @@ class Resampler(ABC):
         return self._draw(weights / weights.sum(), rng, _invert_reference)
 
     @abstractmethod
-    def _draw(self, weights: np.ndarray, rng: np.random.Generator, invert) -> np.ndarray:
+    def _draw(self, weights: np.ndarray, rng: np.random.Generator, invert: Invert) -> np.ndarray:
         """The indices for the normalised ``weights``; ``invert(weights, positions)``
         maps positions in [0, 1) to the indices of the cumulative weights holding them."""
 
@@ -77,7 +82,7 @@ class _InversionResampler(Resampler):
     def positions(n: int, rng: np.random.Generator) -> np.ndarray:
         """n positions (n,) in [0, 1) drawn from ``rng``."""
 
-    def _draw(self, weights, rng, invert):
+    def _draw(self, weights: np.ndarray, rng: np.random.Generator, invert: Invert) -> np.ndarray:
         return invert(weights, self.positions(weights.size, rng))
 
 
@@ -87,10 +92,10 @@ class SystematicResampler(_InversionResampler):
     name = "systematic"
 
     @staticmethod
-    def positions(n, rng):
+    def positions(n: int, rng: np.random.Generator) -> np.ndarray:
         return (rng.random() + np.arange(n)) / n
 
-    def resample(self, weights, rng):
+    def resample(self, weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         # The kernel counts positions below each cumulative weight instead of searching.
         return _systematic(weights / weights.sum(), rng.random())
 
@@ -101,7 +106,7 @@ class StratifiedResampler(_InversionResampler):
     name = "stratified"
 
     @staticmethod
-    def positions(n, rng):
+    def positions(n: int, rng: np.random.Generator) -> np.ndarray:
         return (rng.random(n) + np.arange(n)) / n
 
 
@@ -111,7 +116,7 @@ class MultinomialResampler(_InversionResampler):
     name = "multinomial"
 
     @staticmethod
-    def positions(n, rng):
+    def positions(n: int, rng: np.random.Generator) -> np.ndarray:
         return rng.random(n)
 
 
@@ -121,7 +126,7 @@ class ResidualResampler(Resampler):
 
     name = "residual"
 
-    def _draw(self, weights, rng, invert):
+    def _draw(self, weights: np.ndarray, rng: np.random.Generator, invert: Invert) -> np.ndarray:
         n = weights.size
         copies = np.floor(n * weights).astype(np.int64)
         kept = np.repeat(np.arange(n), copies)
@@ -163,7 +168,13 @@ class ThresholdResampler:
         """:meth:`resample` with the scheme's plain numpy reference."""
         return self._resample(weights, rng, n_eff, self.scheme.resample_reference)
 
-    def _resample(self, weights, rng, n_eff, draw):
+    def _resample(
+        self,
+        weights: np.ndarray,
+        rng: np.random.Generator,
+        n_eff: float | None,
+        draw: Callable[[np.ndarray, np.random.Generator], np.ndarray],
+    ) -> np.ndarray | None:
         if n_eff is None:
             n_eff = effective_sample_size(weights / weights.sum())
         return draw(weights, rng) if n_eff < self.rho * weights.size else None

@@ -70,7 +70,7 @@ from scipy.ndimage import maximum_filter
 from pegame.api import Context, Evader, EvaderObservation
 from pegame.errors import require
 from pegame.navigation import PathFollower, Planner
-from pegame.types import STOP, Plan, Pose, Velocity
+from pegame.types import STOP, Plan, Pose, Region, Velocity
 from pegame.visibility.region import whole_region
 
 
@@ -162,7 +162,7 @@ class ElusiveEvader(Evader):
     def control(self, observation: EvaderObservation) -> Velocity:
         return self.follower.command(observation.pose) if self.plan.goal is not None else STOP
 
-    def costs(self, me: Pose, pursuer: Pose, region=None) -> np.ndarray:
+    def costs(self, me: Pose, pursuer: Pose, region: Region | None = None) -> np.ndarray:
         """Float (H * W,): each cell's cost (s, module docstring) by flat row-major index,
         +inf for the cells that are not candidates. ``region``: the pursuer camera's
         visibility region this tick when the game computed it, else computed here."""
@@ -201,7 +201,7 @@ class ElusiveEvader(Evader):
         off = np.abs(np.arctan2(np.sin(bearing), np.cos(bearing)))  # wrapped to [0, pi]
         return np.maximum(0.0, off - 0.5 * self.context.camera.fov) / self.context.pursuer.w_max
 
-    def _grown(self, mask: np.ndarray, bounds) -> np.ndarray:
+    def _grown(self, mask: np.ndarray, bounds: tuple[int, int, int, int]) -> np.ndarray:
         """Bool (H, W): the cells within hide_margin (m, Chebyshev distance between cell
         centres) of a True cell of ``mask``, whose True cells lie in the rows and columns
         ``bounds`` (r0, r1, c0, c1). A square margin is a little wider than a disc and

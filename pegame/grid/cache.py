@@ -32,7 +32,7 @@ _ATTRIBUTE = "_per_grid_cache"
 class _Cache(dict):
     """The objects derived from one grid, by key; pickled (or deep-copied) empty."""
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[type[_Cache], tuple[()]]:
         return (_Cache, ())
 
 

@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from pegame.errors import require
 from pegame.types import STOP, Body, Pose, Velocity, clamp, wrap_angle
@@ -129,7 +130,7 @@ class PathFollower:
         self.turn_gain = turn_gain
         self.set_path(np.zeros((0, 2)))
 
-    def set_path(self, path) -> None:
+    def set_path(self, path: ArrayLike) -> None:
         """Follow ``path``, float (K, 2) map-frame waypoints (m); an empty path stops."""
         self.path = np.ascontiguousarray(np.asarray(path, dtype=float).reshape(-1, 2))
         seg = np.diff(self.path, axis=0)
