@@ -124,15 +124,20 @@ def load(group: str, name: str) -> type[Plugin]:
     try:
         cls = point.load()
     except (ImportError, AttributeError) as exc:
-        missing = getattr(exc, "name", None)
+        missing, dist = getattr(exc, "name", None), distribution_of(point)
+        # A module's name is not a package name on an index: advising `pip install
+        # <module>` could install someone else's package (typosquatting). The distribution
+        # that declares the entry point knows its dependencies.
+        source = f"the distribution '{dist}'" if dist != "?" else "the distribution"
         hint = (
-            f" It needs the package '{missing}': install it (pip install {missing}) or "
-            f"reinstall the plugin's distribution with its dependencies."
+            f" The module '{missing}' is not installed: reinstall {source} that declares this "
+            "plugin, from where it came (its source directory or index), so that its "
+            "dependencies are installed with it."
             if missing
             else ""
         )
         raise PluginError(
-            f"The {group} plugin '{name}' (distribution '{distribution_of(point)}', "
+            f"The {group} plugin '{name}' (distribution '{dist}', "
             f"{point.value}) failed to import: {exc}.{hint}"
         ) from exc
     check_interface(group, name, point, cls)
