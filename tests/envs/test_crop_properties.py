@@ -63,7 +63,7 @@ def scenes(draw: st.DrawFn) -> tuple[OccupancyGrid, int, float, tuple[float, flo
 Scene = tuple[OccupancyGrid, int, float, tuple[float, float, float]]
 
 
-@settings(max_examples=300)
+@settings(max_examples=150)
 @given(scenes())
 def test_crop_equals_the_reference(scene: Scene) -> None:
     grid, cells, resolution, pose = scene
@@ -72,7 +72,7 @@ def test_crop_equals_the_reference(scene: Scene) -> None:
     assert set(np.unique(expected)) <= {0.0, 1.0}
 
 
-@settings(max_examples=300)
+@settings(max_examples=150)
 @given(scenes())
 def test_both_routes_give_the_reference_cells(scene: Scene) -> None:
     """The lattice, whenever it decides every cell, and the division, always."""
@@ -88,7 +88,7 @@ def test_both_routes_give_the_reference_cells(scene: Scene) -> None:
     assert np.array_equal(divided, expected)
 
 
-@settings(max_examples=150)
+@settings(max_examples=80)
 @given(scenes(), st.data())
 def test_more_obstacles_never_free_a_crop_cell(scene: Scene, data: st.DataObject) -> None:
     grid, cells, resolution, pose = scene

@@ -50,7 +50,7 @@ def test_kernel_equals_reference_and_draws_n_positive_weight_particles(
     assert np.all(weights[fast] > 0.0)
 
 
-@settings(max_examples=200)
+@settings(max_examples=100)
 @given(WEIGHTS, st.lists(st.floats(0.0, 1.0, exclude_max=True) | st.just(0.0), max_size=80))
 def test_inversion_kernel_equals_searchsorted(weights: np.ndarray, positions: list) -> None:
     positions = np.asarray(positions, dtype=np.float64)
@@ -58,7 +58,7 @@ def test_inversion_kernel_equals_searchsorted(weights: np.ndarray, positions: li
         assert np.array_equal(_invert(weights, ordered), _invert_reference(weights, ordered))
 
 
-@settings(max_examples=200)
+@settings(max_examples=100)
 @given(WEIGHTS, st.floats(0.0, 1.0, exclude_max=True) | st.sampled_from([0.0, 0.5]))
 def test_systematic_kernel_equals_searchsorted(weights: np.ndarray, offset: float) -> None:
     normalised = weights / weights.sum()

@@ -33,7 +33,7 @@ def assert_inclusive_steps(values: np.ndarray, start: float, stop: float, step: 
     assert np.all(gaps <= step * (1 + 1e-9))
 
 
-@settings(max_examples=300)
+@settings(max_examples=150)
 @given(CAMERAS)
 def test_tables_span_the_fov_and_the_range_inclusively(camera: Camera) -> None:
     angles, distances, first = ray_tables(camera)
@@ -44,7 +44,7 @@ def test_tables_span_the_fov_and_the_range_inclusively(camera: Camera) -> None:
     assert not angles.flags.writeable and not distances.flags.writeable
 
 
-@settings(max_examples=300)
+@settings(max_examples=150)
 @given(
     st.floats(-10.0, 10.0) | st.floats(-1e12, 1e12) | st.sampled_from([math.pi, MAX_ANGLE]),
     CAMERAS,

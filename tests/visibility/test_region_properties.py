@@ -111,7 +111,7 @@ def test_on_demand_region_equals_the_whole_mask(
     assert not np.any(over & ~whole)
 
 
-@settings(max_examples=150)
+@settings(max_examples=100)
 @given(scenes())
 def test_region_cells_lie_in_the_field_of_view_and_range(
     scene: tuple[OccupancyGrid, Pose, Camera],
