@@ -1,4 +1,4 @@
-"""The README's third-party plugin example works end to end from the command line:
+"""The plugin tutorial's third-party example (docs/tutorials/plugin.md) works end to end from the command line:
 its entry point registers the pursuer and its pegame.configs entry point its config file.
 
 The distribution is made visible to the subprocesses through a hand-written dist-info on
