@@ -157,7 +157,7 @@ def aggregate(
     cells = group_cells(chosen.games, other_factors(chosen.games))
     factors = list(cells[0].factors) if cells else []
     log.info(
-        "%d games in %d cells%s; statistics of %s (%s bootstrap resamples per cell)",
+        "%d games, %d cells%s; statistics of %s (%s bootstrap resamples per cell)",
         len(chosen.games),
         len(cells),
         f", factors beside the paper's axes: {', '.join(factors)}" if factors else "",

@@ -125,10 +125,12 @@ def config_game(
     overrides: tuple[str, ...] = (),
     provenance: dict[str, Any] | None = PROVENANCE,
     kind: str = "game",
+    measures: dict[str, Any] | None = None,
     **settings: Any,
 ) -> dict[str, Any]:
     """A game (or failed) line of the contract: today's fields plus config, config_hash,
-    overrides and provenance."""
+    overrides and provenance; a game's ``measures`` (result.json fields, e.g.
+    ``{"mean_distance": 2.5}``) are added to it."""
     config = job_config(**settings)
     pursuer, evader = config["pursuer"]["name"], config["evader"]["name"]
     line = {
@@ -158,16 +160,29 @@ def config_game(
         "decision_hz": 1.0,
         "tracking_rate": rate,
         "visible_rate": rate,
+        **(measures or {}),
     }
 
 
-def config_job(root: Path, name: str, seeds: range, rates: list[float], **settings: Any) -> Path:
-    """A job of the games ``seeds`` with ``rates``, all of one configuration."""
+def config_job(
+    root: Path,
+    name: str,
+    seeds: range,
+    rates: list[float],
+    measures: list[dict[str, Any]] | None = None,
+    **settings: Any,
+) -> Path:
+    """A job of the games ``seeds`` with ``rates`` (and per game its ``measures``, see
+    :func:`config_game`), all of one configuration."""
     overrides = [f"{k}={v}" for k, v in settings.items()]
+    extra = measures or [{} for _ in seeds]
     return write_job(
         root,
         name,
-        [config_game(s, r, tuple(overrides), **settings) for s, r in zip(seeds, rates)],
+        [
+            config_game(s, r, tuple(overrides), measures=m, **settings)
+            for s, r, m in zip(seeds, rates, extra)
+        ],
         overrides,
     )
 
