@@ -91,7 +91,7 @@ NOISE_BATCH = 32
 
 
 @njit(cache=True)
-def _fill_noise(rng, unit_speeds, normals):
+def _fill_noise(rng: np.random.Generator, unit_speeds: np.ndarray, normals: np.ndarray) -> None:
     """Fill ``unit_speeds`` with U[0, 1) and ``normals`` with N(0, 1) draws from ``rng``.
 
     Numba's Generator runs numpy's algorithms on the same bit generator, so these are the
@@ -104,7 +104,16 @@ def _fill_noise(rng, unit_speeds, normals):
 
 
 @njit(cache=True, error_model="numpy")  # res > 0: no zero-division branch
-def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, frame, blocked):
+def _move_and_locate(
+    particles: np.ndarray,
+    unit_speeds: np.ndarray,
+    normals: np.ndarray,
+    v_max: float,
+    turn_rate_std: float,
+    dt: float,
+    frame: tuple,
+    blocked: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
     """The particles (N, 3) moved by the unicycle model and the flat cell index (N,) each
     lands in (-1 in a blocked cell or off the grid).
 
@@ -149,7 +158,7 @@ def _move_and_locate(particles, unit_speeds, normals, v_max, turn_rate_std, dt, 
 
 
 @njit(cache=True, error_model="numpy")  # two_sigma2 > 0: no zero-division branch
-def _likelihoods(moved, zx, zy, two_sigma2):
+def _likelihoods(moved: np.ndarray, zx: float, zy: float, two_sigma2: float) -> np.ndarray:
     """exp(-|p_i - z|^2 / (2 sigma^2)) per particle (N,): the Gaussian likelihood of a
     detection at (zx, zy) (map frame, m), 0 where it would be below the smallest normal
     float (:func:`pegame.numerics.exps`, the same bits on every CPU)."""
@@ -161,7 +170,15 @@ def _likelihoods(moved, zx, zy, two_sigma2):
 
 
 @njit(cache=True, error_model="numpy")  # divides by total > 0 only: no branch
-def _weigh(prior, cells, in_region, likelihood, detected, in_region_boost, miss_factor):
+def _weigh(
+    prior: np.ndarray,
+    cells: np.ndarray,
+    in_region: np.ndarray,
+    likelihood: np.ndarray,
+    detected: bool,
+    in_region_boost: float,
+    miss_factor: float,
+) -> tuple[np.ndarray, float, float, float]:
     """Measurement update of the weights (module docstring): (weights (N,), total,
     evidence, n_eff).
 
@@ -194,7 +211,7 @@ def _weigh(prior, cells, in_region, likelihood, detected, in_region_boost, miss_
 
 
 @njit(cache=True)
-def _moments(particles, weights):
+def _moments(particles: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Weighted mean (2,) (m) and covariance (2, 2) (m^2) of the particle positions (N, 3)
     with the normalised ``weights`` (N,), in one pass over offsets from the first particle
     (which keeps the cancellation in E[d^2] - E[d]^2 to the cloud's own spread)."""

@@ -184,7 +184,7 @@ class ThresholdResampler:
 
 
 @njit(cache=True)
-def _cumulative(weights):
+def _cumulative(weights: np.ndarray) -> tuple[np.ndarray, int]:
     """(cumulative (N,), last): the cumulative sums of the non-negative ``weights`` (N,),
     accumulated in order and normalised by their total, and the index of the last positive
     weight."""
@@ -201,7 +201,7 @@ def _cumulative(weights):
 
 
 @njit(cache=True)
-def _invert(weights, positions):
+def _invert(weights: np.ndarray, positions: np.ndarray) -> np.ndarray:
     """For each position in [0, 1), the index whose cumulative-weight interval holds it.
 
     Numba version of :func:`_invert_reference`, same indices: the cumulative sum is
@@ -225,7 +225,7 @@ def _invert(weights, positions):
 
 
 @njit(cache=True)
-def _systematic(weights, offset):
+def _systematic(weights: np.ndarray, offset: float) -> np.ndarray:
     """:func:`_invert` of the systematic positions (offset + k) / N, k = 0..N-1, for the
     N ``weights`` and ``offset`` in [0, 1): the same indices, without a search.
 
@@ -257,7 +257,7 @@ def _systematic(weights, offset):
 
 
 @njit(cache=True)
-def _upper_bound(values, value, start):
+def _upper_bound(values: np.ndarray, value: float, start: int) -> int:
     """First index i >= start of the non-decreasing ``values`` with values[i] > value
     (values.size when none), given values[start - 1] <= value: a galloping search, so
     cheap when the answer is near ``start``."""

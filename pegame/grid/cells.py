@@ -19,7 +19,7 @@ from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 
 
 @njit(cache=True, inline="always")
-def point_cell(x, y, frame):
+def point_cell(x: float, y: float, frame: tuple) -> tuple[int, int]:
     """(row, col) of the cell containing map point (x, y) (m); may lie off the grid."""
     dx = x - frame[OX]
     dy = y - frame[OY]
@@ -30,14 +30,14 @@ def point_cell(x, y, frame):
 
 
 @njit(cache=True, inline="always")
-def cell_blocked(blocked, row, col):
+def cell_blocked(blocked: np.ndarray, row: int, col: int) -> bool:
     """True when (row, col) is off the grid or True in the bool (H, W) mask ``blocked``."""
     height, width = blocked.shape
     return row < 0 or row >= height or col < 0 or col >= width or blocked[row, col]
 
 
 @njit(cache=True)
-def cell_centres(cells, width, frame):
+def cell_centres(cells: np.ndarray, width: int, frame: tuple) -> np.ndarray:
     """Float (N, 2): the map-frame centres (x, y) (m) of the flat row-major indices
     ``cells`` (int (N,), row * ``width`` + col), by the operations of
     :meth:`OccupancyGrid.cell_to_world` in its order (the same floats), in one pass instead

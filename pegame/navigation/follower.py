@@ -23,7 +23,7 @@ from pegame.types import STOP, Body, Pose, Velocity, clamp, wrap_angle
 
 
 @njit(cache=True)
-def _search_right(values, x):
+def _search_right(values: np.ndarray, x: float) -> int:
     """``np.searchsorted(values, x, side="right")`` for a sorted float array."""
     lo, hi = 0, values.size
     while lo < hi:
@@ -36,7 +36,15 @@ def _search_right(values, x):
 
 
 @njit(cache=True)
-def _follow(path, seg_len, arc, progress, lookahead, x, y):
+def _follow(
+    path: np.ndarray,
+    seg_len: np.ndarray,
+    arc: np.ndarray,
+    progress: float,
+    lookahead: float,
+    x: float,
+    y: float,
+) -> tuple[float, float, float, float]:
     """One pure-pursuit step on ``path`` for an agent at (x, y) (map frame, m).
 
     path: float (K, 2) waypoints (K >= 1); seg_len: (K-1,) segment lengths; arc: (K,) arc
@@ -76,7 +84,15 @@ def _follow(path, seg_len, arc, progress, lookahead, x, y):
     return to_goal, progress, target_x, target_y
 
 
-def _follow_reference(path, seg_len, arc, progress, lookahead, x, y):
+def _follow_reference(
+    path: np.ndarray,
+    seg_len: np.ndarray,
+    arc: np.ndarray,
+    progress: float,
+    lookahead: float,
+    x: float,
+    y: float,
+) -> tuple[float, float, float, float]:
     """Plain numpy reference of :func:`_follow`, same arguments and result."""
     xy = np.array([x, y])
     to_goal = float(np.hypot(*(path[-1] - xy)))

@@ -52,7 +52,7 @@ def obstacle_distance_reference(grid: OccupancyGrid) -> np.ndarray:
 
 
 @njit(cache=True)
-def _feature_distances(nearest, resolution):
+def _feature_distances(nearest: np.ndarray, resolution: float) -> np.ndarray:
     """Float64 (H, W): distance (m) from each inner cell of the padded (H + 2, W + 2)
     grid to its feature ``nearest[:, row, col]`` (int32 (2, H + 2, W + 2) row and column),
     as scipy computes it: sqrt((dr * res)^2 + (dc * res)^2), each factor a float64."""

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import heapq
 import math
+from collections.abc import Iterator
 from typing import NamedTuple
 
 import numpy as np
@@ -85,13 +86,15 @@ class BucketPool(NamedTuple):
         return cls(np.empty(size, np.int32), np.empty(size, np.int32))
 
 
-def pad_flat(array: np.ndarray, fill) -> np.ndarray:
+def pad_flat(array: np.ndarray, fill: float | bool) -> np.ndarray:
     """``array`` (H, W) padded with one ring of ``fill``, flattened to ((H+2) * (W+2),)."""
     return np.pad(array, 1, constant_values=fill).ravel()
 
 
 @njit(cache=True)
-def _move_tables(padded_width, moves, resolution):
+def _move_tables(
+    padded_width: int, moves: np.ndarray, resolution: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Flat index offsets (cells) and lengths (m) of the 8 moves."""
     offsets = moves[:, 0] * padded_width + moves[:, 1]
     lengths = np.empty(8)
@@ -193,7 +196,16 @@ def dijkstra(
 
 
 @njit(cache=True)
-def _sift_up(keys, ties, nodes, pos, slot, node, key, tie):
+def _sift_up(
+    keys: np.ndarray,
+    ties: np.ndarray,
+    nodes: np.ndarray,
+    pos: np.ndarray,
+    slot: int,
+    node: int,
+    key: float,
+    tie: float,
+) -> None:
     """Place ``node`` with (key, tie) at heap ``slot`` or above.
 
     The heap is an indexed binary min-heap with decrease-key: per slot a key, a tie-break
@@ -215,7 +227,7 @@ def _sift_up(keys, ties, nodes, pos, slot, node, key, tie):
 
 
 @njit(cache=True)
-def _pop(keys, ties, nodes, pos, size):
+def _pop(keys: np.ndarray, ties: np.ndarray, nodes: np.ndarray, pos: np.ndarray, size: int) -> int:
     """Remove and return the heap's minimum node; ``size`` is the size before removal."""
     top = nodes[0]
     pos[top] = -1
@@ -250,7 +262,7 @@ def _pop(keys, ties, nodes, pos, size):
 
 
 @njit(cache=True)
-def _octile(resolution, row, col, goal_row, goal_col):
+def _octile(resolution: float, row: int, col: int, goal_row: int, goal_col: int) -> float:
     """Octile distance (m) between two cells: a lower bound of any path cost."""
     dr = abs(row - goal_row)
     dc = abs(col - goal_col)
@@ -347,7 +359,7 @@ CLOSED = -2
 
 
 @njit(cache=True)
-def _key(f, tie_quantum):
+def _key(f: float, tie_quantum: float) -> float:
     """The heap key of f (m): f itself, or f rounded down to a multiple of ``tie_quantum``."""
     if tie_quantum > 0.0:
         return math.floor(f / tie_quantum) * tie_quantum
@@ -355,7 +367,7 @@ def _key(f, tie_quantum):
 
 
 @njit(cache=True)
-def _landmark_bound(landmark_costs, to_goal, v, h):
+def _landmark_bound(landmark_costs: np.ndarray, to_goal: np.ndarray, v: int, h: float) -> float:
     """The largest of ``h`` and the landmark bounds |cost(L, goal) - cost(L, v)| (m),
     subtracted in float64 (exactly, for float32 costs: the consistency argument of
     ``Planner._landmark_table`` needs the difference unrounded)."""
@@ -365,7 +377,7 @@ def _landmark_bound(landmark_costs, to_goal, v, h):
 
 
 @njit(cache=True)
-def _trace(parent, start, goal):
+def _trace(parent: np.ndarray, start: int, goal: int) -> np.ndarray:
     """The flat cells from ``start`` to ``goal`` along the ``parent`` links."""
     count = 1
     node = goal
@@ -383,7 +395,13 @@ def _trace(parent, start, goal):
 # -------------------------------------------------------------- plain-Python references
 
 
-def _reference_neighbours(traversable, multipliers, weighted, resolution, cell):
+def _reference_neighbours(
+    traversable: np.ndarray,
+    multipliers: np.ndarray,
+    weighted: bool,
+    resolution: float,
+    cell: tuple[int, int],
+) -> Iterator[tuple[tuple[int, int], float]]:
     """Yield (neighbour cell, step cost m) for the allowed moves from ``cell``."""
     height, width = traversable.shape
     r, c = cell
@@ -401,7 +419,13 @@ def _reference_neighbours(traversable, multipliers, weighted, resolution, cell):
         yield (nr, nc), step
 
 
-def distance_field_reference(traversable, multipliers, weighted, resolution, source):
+def distance_field_reference(
+    traversable: np.ndarray,
+    multipliers: np.ndarray,
+    weighted: bool,
+    resolution: float,
+    source: tuple[int, int],
+) -> np.ndarray:
     """Plain-Python Dijkstra with heapq; same contract as :func:`dijkstra` but takes and
     returns (row, col) cells: float64 (H, W) costs (m) from ``source``, inf if unreachable."""
     dist = np.full(traversable.shape, np.inf)
@@ -419,18 +443,24 @@ def distance_field_reference(traversable, multipliers, weighted, resolution, sou
     return dist
 
 
-def astar_reference(traversable, multipliers, resolution, start, goal):
+def astar_reference(
+    traversable: np.ndarray,
+    multipliers: np.ndarray,
+    resolution: float,
+    start: tuple[int, int],
+    goal: tuple[int, int],
+) -> tuple[float, list[tuple[int, int]]]:
     """Plain-Python A* with heapq and the octile heuristic on the weighted grid.
 
     Returns (cost m, list of (row, col) cells from start to goal), or (inf, []).
     """
 
-    def heuristic(cell):
+    def heuristic(cell: tuple[int, int]) -> float:
         dr, dc = abs(cell[0] - goal[0]), abs(cell[1] - goal[1])
         return resolution * (max(dr, dc) + (SQRT2 - 1.0) * min(dr, dc))
 
     g = {start: 0.0}
-    parent = {start: None}
+    parent: dict[tuple[int, int], tuple[int, int] | None] = {start: None}
     queue = [(heuristic(start), start)]
     while queue:
         f, cell = heapq.heappop(queue)
@@ -446,6 +476,6 @@ def astar_reference(traversable, multipliers, resolution, start, goal):
     if goal not in g:
         return math.inf, []
     path = [goal]
-    while parent[path[-1]] is not None:
-        path.append(parent[path[-1]])
+    while (previous := parent[path[-1]]) is not None:
+        path.append(previous)
     return g[goal], path[::-1]

@@ -167,7 +167,9 @@ def _holds(cells: np.ndarray, sight: tuple, eye: tuple, rays: tuple) -> np.ndarr
 
 
 @njit(cache=True, inline="always")
-def _in_cells(x, y, ox, oy, yaw, resolution):
+def _in_cells(
+    x: float, y: float, ox: float, oy: float, yaw: float, resolution: float
+) -> tuple[float, float]:
     """(u, v): the map point (x, y) (m) in continuous cell coordinates, u along columns and
     v along rows, from the grid origin (ox, oy, yaw) (m, m, rad); not floored."""
     du, dv = (x - ox) / resolution, (y - oy) / resolution

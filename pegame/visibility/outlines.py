@@ -66,7 +66,16 @@ def outline_rays(camera: Camera, rays: int) -> OutlineRays:
     )
 
 
-def outlines_reference(runs, frame, rays, xs, ys, thetas, z, jump=False):
+def outlines_reference(
+    runs: np.ndarray,
+    frame: tuple,
+    rays: OutlineRays,
+    xs: np.ndarray,
+    ys: np.ndarray,
+    thetas: np.ndarray,
+    z: float,
+    jump: bool = False,
+) -> np.ndarray:
     """Closed (P, n + m + 1, 3) float32 polygons (map frame, m, at height z) around the
     visibility regions of the camera at the P poses (xs, ys, thetas) (m, m, rad): the far
     ends of the n rays of ``rays`` (:class:`OutlineRays`), then its m points back along

@@ -49,7 +49,9 @@ def ray_directions(pose: Pose, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
 
 
 @njit(cache=True)
-def directions(theta, angles, first, stop):
+def directions(
+    theta: float, angles: np.ndarray, first: int, stop: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Unit directions (cos, sin) (each (stop - first,)) of the rays at angles[first:stop]
     (rad) from the heading theta (rad), by the vectorised :func:`pegame.numerics.sin_cos`.
     Every path takes its directions from here, so they all sample the same points."""

@@ -63,7 +63,16 @@ _EDGE = 1e-9
 
 
 @njit(cache=True, inline="always")
-def _ray_cells(px, py, ray, distances, frame, shape, divide, cells):
+def _ray_cells(
+    px: float,
+    py: float,
+    ray: tuple[float, float],
+    distances: np.ndarray,
+    frame: tuple,
+    shape: tuple[int, int],
+    divide: bool,
+    cells: np.ndarray,
+) -> bool:
     """Flat row-major cell index (row * width + col) of every sample of one ray, -1 off the grid.
 
     The ray starts at (px, py) (map frame, m) along ``ray`` = (cos, sin); sample j is at
@@ -105,7 +114,17 @@ def _ray_cells(px, py, ray, distances, frame, shape, divide, cells):
 
 
 @njit(cache=True)
-def march(blocked, cos_a, sin_a, distances, first, px, py, frame, mask):
+def march(
+    blocked: np.ndarray,
+    cos_a: np.ndarray,
+    sin_a: np.ndarray,
+    distances: np.ndarray,
+    first: int,
+    px: float,
+    py: float,
+    frame: tuple,
+    mask: np.ndarray,
+) -> tuple[int, int, int, int]:
     """Mark in ``mask`` the cells seen along each ray, stopping at the first blocked one,
     and return the bounds (r0, r1, c0, c1) of the marked cells: rows [r0, r1) and columns
     [c0, c1) (r1 <= r0 when none).
@@ -208,7 +227,7 @@ class MaskRegion:
 
 
 @njit(cache=True)
-def lookup(flat_mask, cells, candidates):
+def lookup(flat_mask: np.ndarray, cells: np.ndarray, candidates: np.ndarray) -> np.ndarray:
     """flat_mask[cells[i]] where candidates[i] and cells[i] >= 0, else False (N,)."""
     out = np.zeros(cells.size, dtype=np.bool_)
     for i in range(cells.size):

@@ -37,7 +37,15 @@ def _line_of_sight_reference(grid: OccupancyGrid, a_xy: XY, b_xy: XY, step: floa
 
 
 @njit(cache=True)
-def _segment_clear(blocked, ax, ay, bx, by, step, frame):
+def _segment_clear(
+    blocked: np.ndarray,
+    ax: float,
+    ay: float,
+    bx: float,
+    by: float,
+    step: float,
+    frame: tuple,
+) -> bool:
     """Kernel of :func:`line_of_sight`: the same samples as the numpy reference, where
     ``np.linspace(0, 1, count + 1)`` gives t = k * (1 / count), and the end point itself."""
     count = max(1, math.ceil(math.hypot(bx - ax, by - ay) / step))
