@@ -34,3 +34,13 @@ def test_the_site_builds_strictly_offline(tmp_path):
     reference = (tmp_path / "site" / "reference" / "api" / "index.html").read_text()
     assert "pegame.api.Pursuer" in reference  # the API reference came from the docstrings
     assert ":class:`" not in reference  # Sphinx roles were turned into code
+
+
+def test_the_results_pages_tables_are_those_generated_from_the_committed_tables():
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "docs" / "results" / "tables.py"), "--check"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
