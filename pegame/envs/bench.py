@@ -8,9 +8,12 @@ import os
 import statistics
 import time
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover - typing only (imported where used)
+    from pegame.envs.vector import EvasionVectorEnv, PursuitVectorEnv
 
 
 def bench_steps_per_second(
@@ -64,7 +67,7 @@ def _rss_bytes() -> int:
         return 0
 
 
-def _array_bytes(env) -> int:
+def _array_bytes(env: PursuitVectorEnv | EvasionVectorEnv) -> int:
     """Bytes of a batched env's arrays: its games' state, the opponent's action table and
     one batch of observations."""
     game = env.game
@@ -73,7 +76,9 @@ def _array_bytes(env) -> int:
     return sum(a.nbytes for a in game.state) + (0 if table is None else table.nbytes) + observation
 
 
-def _vector_steps_per_second(env, actions: np.ndarray, threads: int) -> float:
+def _vector_steps_per_second(
+    env: PursuitVectorEnv | EvasionVectorEnv, actions: np.ndarray, threads: int
+) -> float:
     """Env steps (games x batched steps) per second of ``env`` over the batched
     ``actions`` (steps, N, 2), on ``threads`` numba threads, no game ending on the way."""
     import numba

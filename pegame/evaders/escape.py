@@ -122,7 +122,9 @@ def disc_half_widths(margin: float, resolution: float) -> np.ndarray:
 
 
 @njit(cache=True)
-def _grow(visible, r0, r1, c0, c1, half_widths):
+def _grow(
+    visible: np.ndarray, r0: int, r1: int, c0: int, c1: int, half_widths: np.ndarray
+) -> tuple[np.ndarray, int, int]:
     """The cells within the disc of ``half_widths`` of a cell of ``visible`` (H, W), whose
     True cells all lie in rows [r0, r1) and columns [c0, c1): a bool window and its top
     row and left column."""
@@ -151,7 +153,9 @@ def _grow(visible, r0, r1, c0, c1, half_widths):
 
 
 @njit(cache=True)
-def _exposed_positions(exposed, top, left, width, position):
+def _exposed_positions(
+    exposed: np.ndarray, top: int, left: int, width: int, position: np.ndarray
+) -> np.ndarray:
     """Increasing indices, in a component's row-major cell list, of its cells that are
     True in the ``exposed`` window at (top, left); ``position`` maps a flat cell index to
     its index in the list, -1 outside the list."""
@@ -167,7 +171,7 @@ def _exposed_positions(exposed, top, left, width, position):
 
 
 @njit(cache=True)
-def _tile_bounds(boxes, ex, ey, px, py):
+def _tile_bounds(boxes: np.ndarray, ex: float, ey: float, px: float, py: float) -> np.ndarray:
     """Lower bound (T,) of effort / dist over each tile's box (x min, x max, y min,
     y max) (m) of cell centres: the box's nearest distance to the evader at (ex, ey) over
     its farthest distance to the pursuer at (px, py)."""
@@ -182,7 +186,7 @@ def _tile_bounds(boxes, ex, ey, px, py):
 
 
 @njit(cache=True, inline="always")
-def _cell_centre(row, col, frame):
+def _cell_centre(row: int, col: int, frame: tuple) -> tuple[float, float]:
     """Map-frame centre (x, y) (m) of cell (row, col), by the operations of
     :meth:`pegame.grid.OccupancyGrid.cell_to_world` (so the same floats)."""
     u = (float(col) + 0.5) * frame[RESOLUTION]
@@ -263,7 +267,7 @@ def _best_candidate(
 
 
 @njit(cache=True)
-def _sample_positions(skipped, count, step):
+def _sample_positions(skipped: np.ndarray, count: int, step: int) -> np.ndarray:
     """Indices in a list of the candidates numbered 0, step, 2 step, ... < count, where
     the candidates are the list's entries except the increasing indices ``skipped``."""
     picked = np.empty((count + step - 1) // step, dtype=np.int64)
@@ -281,7 +285,9 @@ def _sample_positions(skipped, count, step):
 
 
 @njit(cache=True)
-def _group_by_tile(candidate, frame):
+def _group_by_tile(
+    candidate: np.ndarray, frame: tuple
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The cells of the bool (H, W) mask ``candidate``, row-major and grouped by tile.
 
     Returns (cells, position, rows, cols, starts, boxes): the flat indices (K,) in

@@ -203,7 +203,16 @@ class SmartPursuer(Pursuer):
 
 
 @njit(cache=True)
-def _straight_clear(blocked, x, y, cos_theta, sin_theta, distance, n, frame):
+def _straight_clear(
+    blocked: np.ndarray,
+    x: float,
+    y: float,
+    cos_theta: float,
+    sin_theta: float,
+    distance: float,
+    n: int,
+    frame: tuple,
+) -> bool:
     """True when the n samples at ``np.linspace(distance / n, distance, n)`` m along the
     heading (cos_theta, sin_theta) from (x, y) (map frame, m) are all on the grid and, except
     those in the start's own cell, out of the bool (H, W) mask ``blocked``.
@@ -227,7 +236,15 @@ def _straight_clear(blocked, x, y, cos_theta, sin_theta, distance, n, frame):
     return True
 
 
-def _straight_clear_reference(grid: OccupancyGrid, blocked, x, y, theta, distance, n) -> bool:
+def _straight_clear_reference(
+    grid: OccupancyGrid,
+    blocked: np.ndarray,
+    x: float,
+    y: float,
+    theta: float,
+    distance: float,
+    n: int,
+) -> bool:
     """Plain numpy reference of :func:`_straight_clear` (heading ``theta`` rad)."""
     s = np.linspace(distance / n, distance, n)
     rows, cols = grid.world_to_cell(x + s * math.cos(theta), y + s * math.sin(theta))
