@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from importlib.resources import files
 from pathlib import Path
 
@@ -10,8 +11,16 @@ from omegaconf import OmegaConf
 
 from pegame import registry
 from pegame.api import PLUGIN_KINDS
-from pegame.config import EnvConfig, GameConfig, Schema, check_known_keys, resolve_map_path, typed
-from pegame.errors import ConfigError
+from pegame.config import (
+    EnvConfig,
+    GameConfig,
+    Schema,
+    check_known_keys,
+    compose,
+    resolve_map_path,
+    typed,
+)
+from pegame.errors import ConfigError, PegameError
 from pegame.grid import load_map
 from pegame.types import Camera
 
@@ -126,3 +135,65 @@ def test_the_schema_has_one_node_per_plugin_kind():
     names = [f.name for f in fields(Schema)]
     assert [n for n in names if n in PLUGIN_KINDS] == list(PLUGIN_KINDS)
     assert set(names) - set(PLUGIN_KINDS) == {"game", "camera", "env", "team", "resume"}
+
+
+@pytest.mark.parametrize(
+    ("override", "key", "allowed"),
+    [
+        ("game.t_max=inf", "game.t_max", "a finite number"),
+        ("game.t_max=1e400", "game.t_max", "a finite number"),  # YAML reads it as inf
+        ("game.t_max=1e300", "game.t_max", "at most 8640000 simulator steps per game"),
+        ("game.control_hz=1e300", "game.t_max", "at most 8640000 simulator steps per game"),
+        ("game.physics_hz=nan", "game.physics_hz", "a finite number"),
+        ("camera.far=inf", "camera.far", "a finite number"),
+        ("camera.far=1e308", "camera.far", "at most 100000 rays per view"),
+        ("camera.far=1e12", "camera.far", "at most 100000 rays per view"),
+        ("camera.angle_step=1e-9", "camera.angle_step", "at most 100000 rays per view"),
+        ("evader.v_max=inf", "evader.v_max", "a finite number"),
+        ("pursuer.a_max=nan", "pursuer.a_max", "a number or .inf"),
+    ],
+)
+def test_infinite_and_unbounded_values_are_refused_before_the_first_game(
+    compose_config, tmp_path, override, key, allowed
+):
+    from pegame.job import run_job
+
+    with pytest.raises(ConfigError) as info:
+        run_job(compose_config(["recorder=none", "env=hall", override]), tmp_path)
+    assert f"Invalid value for '{key}'" in str(info.value) and allowed in str(info.value)
+    assert not (tmp_path / "results.jsonl").exists()
+
+
+def test_infinity_stays_a_setting_where_it_is_the_default(compose_config):
+    from pegame.game import Scenario
+
+    scenario = Scenario(compose_config(["pursuer.a_max=inf", "evader.alpha_max=inf"]))
+    assert scenario.context.pursuer.a_max == math.inf == scenario.context.evader.alpha_max
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["env=hal"], "Unknown map 'hal'. Did you mean 'hall'?"),
+        (["-m", "env=hall,hal"], "Unknown map 'hal'. Did you mean 'hall'?"),
+        (["pursuer=smrt"], "Unknown pursuer 'smrt'. Did you mean 'smart'?"),
+        (["game.tmax=5"], "Unknown key 'game.tmax'. Did you mean 'game.t_max'?"),
+        (["camera.fav=1"], "Unknown key 'camera.fav'. Did you mean 'camera.fov'?"),
+        (["gmae.t_max=5"], "Unknown key 'gmae.t_max'. Did you mean 'game'?"),
+    ],
+)
+def test_misspelt_choices_and_keys_get_did_you_mean_before_hydra(args, message):
+    from pegame.overrides import check_overrides
+
+    with pytest.raises(PegameError, match=message):
+        check_overrides(args)
+    with pytest.raises(PegameError, match=message):
+        compose([a for a in args if a != "-m"])
+
+
+def test_added_keys_and_deletions_are_left_to_hydra_and_the_schema():
+    from pegame.overrides import check_overrides
+
+    check_overrides(
+        ["+game.extra=1", "~recorder", "++resume=true", "hydra.run.dir=x", "pursuer.k_v=1"]
+    )

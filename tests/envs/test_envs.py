@@ -316,3 +316,20 @@ def test_unknown_options_suggest_the_closest():
         parallel_env(overrides=SHORT, crop_cell=8)
     with pytest.raises(ConfigError, match="'crop_resolution'"):
         parallel_env(overrides=SHORT, crop_resolution=0.0)
+
+
+@pytest.mark.parametrize(
+    ("env_id", "team"), [(IDS[0], "team.pursuers=2"), (IDS[1], "team.evaders=2")]
+)
+def test_the_single_agent_envs_refuse_a_team_naming_the_key(env_id, team):
+    # they built the team game and failed at reset with KeyError: 'pursuer' ('evader')
+    key = team.split("=")[0]
+    with pytest.raises(ConfigError, match=rf"Invalid value for '{key}' in {env_id}: 2"):
+        gymnasium.make(env_id, overrides=[*SHORT, team])
+
+
+def test_a_misspelt_opponent_gets_did_you_mean():
+    from pegame.errors import PluginChoiceError
+
+    with pytest.raises(PluginChoiceError, match="Unknown evader 'smrt'. Did you mean 'smart'?"):
+        gymnasium.make(IDS[0], overrides=SHORT, opponent="smrt")

@@ -201,3 +201,11 @@ def test_bad_actions_and_unsupported_configs_are_clear_errors():
         vector_env(2, overrides=SHORT + ["detector.miss_probability=0.1"])
     with pytest.raises(ConfigError, match="role"):
         vector_env(2, overrides=SHORT, role="referee")
+
+
+def test_a_team_is_refused_not_played_as_1v1():
+    # vector_env(..., overrides=["team.pursuers=3", "team.evaders=2"]) played 1v1 silently
+    with pytest.raises(ConfigError, match="Invalid value for 'team.pursuers' in a batched env: 3"):
+        vector_env(2, overrides=["env=hall", "team.pursuers=3", "team.evaders=2"])
+    with pytest.raises(ConfigError, match="'team.evaders' in a batched env: 2"):
+        vector_env(2, overrides=["env=hall", "team.evaders=2"], role="both")
