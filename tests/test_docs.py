@@ -4,12 +4,17 @@ build needs nothing from the network."""
 
 from __future__ import annotations
 
+import math
 import os
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from pegame.api import EvaderObservation, Pose
+from pegame.testing import ConformanceError, check_config_errors, small_context
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -44,3 +49,25 @@ def test_the_results_pages_tables_are_those_generated_from_the_committed_tables(
         timeout=60,
     )
     assert done.returncode == 0, done.stderr
+
+
+def tutorial_code(page: str, first_line: str) -> str:
+    """The Python block of ``docs/<page>`` that starts with ``first_line``."""
+    text = (ROOT / "docs" / page).read_text()
+    blocks = text.split("```python\n")[1:]
+    return next(block.split("```")[0] for block in blocks if block.startswith(first_line))
+
+
+def test_the_tutorials_evader_implements_its_interface_and_walks_away(tmp_path, monkeypatch):
+    (tmp_path / "fleer.py").write_text(tutorial_code("tutorials/plugin.md", "# fleer.py"))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    from fleer import Fleer  # the tutorial's module, written above
+
+    check_config_errors("evader", Fleer, {"gain": -1.0})
+    with pytest.raises(ConformanceError):
+        check_config_errors("evader", Fleer, {"gain": 1.0})  # a valid value is no bad value
+    fleer = Fleer(Fleer.Config(), small_context(), np.random.default_rng(0))
+    me, pursuer = Pose(2.0, 1.0, 0.0), Pose(3.0, 1.0, 0.0)  # the pursuer straight ahead
+    command = fleer.control(EvaderObservation(0.0, me, pursuer))
+    assert command.v == fleer.config.v_max
+    assert command.w == pytest.approx(fleer.config.gain * math.pi)  # turn round
