@@ -334,7 +334,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         comparisons = [parse_compare(text) for text in args.compare]
-        measure(args.metric)
+        measured = measure(args.metric)
     except (CompareError, MeasureError) as error:
         parser.error(str(error))
     for directory in args.sweep_dirs:
@@ -356,11 +356,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     for warning in report["provenance"]["warnings"]:
         print(f"WARNING: {warning}")
-    if args.metric != TRACKING.name:
+    if measured is not TRACKING:
         print(
-            f"tables, figures and comparisons of {args.metric} -> "
-            f"{named('table1.md', measure(args.metric))}; the hypotheses are tested on the "
-            f"tracking rate"
+            f"tables, figures and comparisons of {measured.name} -> "
+            f"{named('table1.md', measured)}; the hypotheses are tested on the tracking rate"
         )
     for h in report["hypotheses"]:
         paired = h["summary_paired"]
@@ -373,8 +372,10 @@ def main(argv: list[str] | None = None) -> int:
         print(
             f"{c['factor']}: {c['b']} against {c['a']}: significant in {s['significant']} of "
             f"{s['tested']} tested cells -> "
-            f"{named(file_stem(c['factor']) + '.md', measure(args.metric))}"
+            f"{named(file_stem(c['factor']) + '.md', measured)}"
         )
+    if "estimation" in report:
+        print("the estimator's error while unseen, N_eff and resamplings per cell -> estimation.md")
     for s in report.get("vs_paper", {}).get("summaries", []):
         where = f" ({facet_text(s['factors'])})" if s["factors"] else ""
         print(

@@ -12,6 +12,7 @@ over the games that define it, and its n counts them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from difflib import get_close_matches
 from typing import Any
 
 from pegame.errors import PegameError
@@ -82,10 +83,12 @@ class MeasureError(PegameError, ValueError):
 def measure(name: str) -> Measure:
     """The measure called ``name``; :class:`MeasureError` listing the allowed names."""
     if name not in MEASURES:
+        close = get_close_matches(name, MEASURES, n=1)
         raise MeasureError(
-            f"--metric {name!r} is not a measure of result.json. The report aggregates one "
-            f"of its numeric measures: {', '.join(MEASURES)} (default tracking_rate; rates "
-            f"in %, distances in m, times in s)."
+            f"--metric {name!r} is not a measure of result.json"
+            + (f" (did you mean {close[0]}?)" if close else "")
+            + f". The report aggregates one of its numeric measures: {', '.join(MEASURES)} "
+            f"(default tracking_rate; rates in %, distances in m, times in s)."
         )
     return MEASURES[name]
 

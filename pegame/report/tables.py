@@ -80,6 +80,11 @@ def render_table_md(layout: Layout, notes: list[str], measure: Measure = TRACKIN
             "configurations."
             if layout.factors
             else "."
+        )
+        + (
+            ""
+            if measure is TRACKING
+            else " The hypotheses (hypotheses.md) are tested on the tracking rate."
         ),
         "",
         "| " + " | ".join(header) + " |",

@@ -44,7 +44,7 @@ def test_an_unknown_metric_is_one_paragraph_naming_the_measures_and_exit_2(tmp_p
         report.main([str(tmp_path), "--metric", "estimation_error"])
     assert stop.value.code == 2
     error = capsys.readouterr().err.splitlines()[-1]
-    assert "'estimation_error' is not a measure of result.json" in error
+    assert "'estimation_error' is not a measure of result.json (did you mean " in error
     assert "mean_estimation_error, n_eff_mean" in error and "mean_distance" in error
     with pytest.raises(report.MeasureError):
         measure("nope")
@@ -66,6 +66,7 @@ def test_metric_tables_are_of_that_measure_over_the_games_that_define_it(tmp_pat
     assert cell["ci_low"] >= 1.0 and cell["ci_high"] <= 3.0
     md = (out / "table1_mean_distance.md").read_text()
     assert md.startswith("# Table 1: mean distance\n")
+    assert "The hypotheses (hypotheses.md) are tested on the tracking rate." in md
     assert table_rows(md)[2] == ["1", f"2.00 m [{cell['ci_low']:.2f}, {cell['ci_high']:.2f}] n=3"]
     (row,) = csv.DictReader((out / "table1_mean_distance.csv").open())
     assert float(row["mean"]) == 2.0 and row["n"] == "3"
