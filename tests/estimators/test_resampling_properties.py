@@ -52,8 +52,8 @@ def test_kernel_equals_reference_and_draws_n_positive_weight_particles(
 
 @settings(max_examples=100)
 @given(WEIGHTS, st.lists(st.floats(0.0, 1.0, exclude_max=True) | st.just(0.0), max_size=80))
-def test_inversion_kernel_equals_searchsorted(weights: np.ndarray, positions: list) -> None:
-    positions = np.asarray(positions, dtype=np.float64)
+def test_inversion_kernel_equals_searchsorted(weights: np.ndarray, drawn: list[float]) -> None:
+    positions = np.asarray(drawn, dtype=np.float64)
     for ordered in (positions, np.sort(positions)):  # multinomial, and sorted as the others
         assert np.array_equal(_invert(weights, ordered), _invert_reference(weights, ordered))
 

@@ -81,7 +81,8 @@ def arc_by_quadrature(pose: Pose, cmd: Velocity, dt: float) -> tuple[float, floa
     t = 0.5 * dt * (NODES + 1.0)
     heading = pose.theta + cmd.w * t
     scale = 0.5 * dt * cmd.v
-    return pose.x + scale * WEIGHTS @ np.cos(heading), pose.y + scale * WEIGHTS @ np.sin(heading)
+    dx, dy = scale * WEIGHTS @ np.cos(heading), scale * WEIGHTS @ np.sin(heading)
+    return pose.x + float(dx), pose.y + float(dy)
 
 
 @settings(max_examples=300)

@@ -76,7 +76,9 @@ def scenes(draw: st.DrawFn) -> tuple[OccupancyGrid, Pose, Camera]:
     return grid, draw(poses(grid)), draw(cameras())
 
 
-def grid_coordinates(grid: OccupancyGrid, x, y) -> tuple[np.ndarray, np.ndarray]:
+def grid_coordinates(
+    grid: OccupancyGrid, x: np.ndarray, y: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Continuous (u, v) of map points (m) in cells along the columns and rows."""
     c, s = grid.frame.cos_yaw, grid.frame.sin_yaw
     dx, dy = np.asarray(x) - grid.origin[0], np.asarray(y) - grid.origin[1]
@@ -99,8 +101,8 @@ def test_on_demand_region_equals_the_whole_mask(
 ) -> None:
     grid = scene[0]
     whole = visibility_region(*scene)
-    cells = data.draw(st.lists(st.integers(-1, grid.blocked.size - 1), max_size=30))
-    cells = np.asarray(cells, dtype=np.int64)
+    drawn = data.draw(st.lists(st.integers(-1, grid.blocked.size - 1), max_size=30))
+    cells = np.asarray(drawn, dtype=np.int64)
     expected = np.where(cells >= 0, whole.ravel()[np.maximum(cells, 0)], False)
     assert np.array_equal(VisibilityRegion(*scene).holds(cells), expected)
     top, left = data.draw(st.integers(-3, grid.height)), data.draw(st.integers(-3, grid.width))
