@@ -165,6 +165,8 @@ def aggregate(
         f"{BOOT_RESAMPLES:,}",
     )
     described = [cell.summary(measured.name) for cell in cells]
+    if cells and not any(d["n"] for d in described):
+        log.warning("no game defines %s: its tables and figures are empty", measured.name)
     log.info("testing hypotheses H1-H3 on the tracking rate")
     return {
         "sweep_dirs": [str(d) for d in dirs],

@@ -232,12 +232,13 @@ def curve_figure(
     for ax in axes:
         for handle, label in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(label, handle)
-    fig.legend(
-        list(handles.values()),
-        list(handles),
-        loc="outside lower center",
-        ncols=min(3, len(handles)),
-    )
+    if handles:
+        fig.legend(
+            list(handles.values()),
+            list(handles),
+            loc="outside lower center",
+            ncols=min(3, len(handles)),
+        )
     fig.suptitle(f"{heading(measure)} against {factor} (mean, 95% CI)")
     return fig
 

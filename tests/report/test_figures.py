@@ -108,3 +108,12 @@ def test_the_report_writes_the_curve_of_the_chosen_measure(tmp_path):
         .read_text()
         .count("visible rate")
     )
+
+
+def test_a_curve_of_a_measure_no_game_defines_has_no_lines_and_no_legend(tmp_path):
+    particle_sweep(tmp_path)
+    cells = cells_of(tmp_path)
+    handoffs = MEASURES["handoffs"]
+    described = [c.summary(handoffs.name) for c in cells]
+    fig = figures(cells, described, handoffs)["curve_estimator.n_particles"]
+    assert fig.legends == [] and all(not ax.get_lines() for ax in fig.axes)

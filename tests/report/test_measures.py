@@ -139,3 +139,13 @@ def test_the_report_logs_each_stage(tmp_path, caplog):
         "drawing the figures (PNG and SVG)",
         f"writing 13 files into {tmp_path / 'out'}",
     ]
+
+
+@pytest.mark.slow
+def test_a_measure_no_game_defines_gives_empty_cells_and_a_warning(tmp_path, caplog):
+    write_job(tmp_path, "0", [game("hall", 1.0, "S-R", s, 0.5) for s in range(2)])
+    with caplog.at_level(logging.WARNING, logger="pegame.report"):
+        result = report.write_report(tmp_path, metric="handoffs")
+    assert [c["n"] for c in result["cells"]] == [0]
+    assert "no game defines handoffs" in caplog.text
+    assert table_rows((tmp_path / "table1_handoffs.md").read_text())[2] == ["1", "–"]
