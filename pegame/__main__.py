@@ -109,7 +109,7 @@ def adopter(cfg: DictConfig, out_dir: str, held: HeldLog) -> Callable[[], None]:
     texts = {
         "config.yaml": OmegaConf.to_yaml(cfg),
         "hydra.yaml": OmegaConf.to_yaml(hydra_cfg),
-        "overrides.yaml": OmegaConf.to_yaml(hydra_cfg.hydra.overrides.task),
+        "overrides.yaml": OmegaConf.to_yaml(HydraConfig.get().overrides.task),
     }
 
     def adopt() -> None:

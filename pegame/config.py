@@ -282,6 +282,7 @@ def typed(node: Mapping[str, Any], schema: type, key: str) -> Any:
         )
     try:
         merged = OmegaConf.merge(OmegaConf.structured(schema), params)
+        assert isinstance(merged, DictConfig)  # a dataclass schema merges to a mapping
         check_finite(merged, schema, key)
         return OmegaConf.to_object(merged)
     except OmegaConfBaseException as exc:

@@ -300,7 +300,7 @@ def write_single(outcome: Outcome, game: Game, out_dir: Path) -> None:
 
 
 def record_failure(
-    out_dir: Path, seed: int, cfg: DictConfig, exc: Exception, identity: dict[str, Any]
+    out_dir: Path, seed: int, cfg: DictConfig, exc: BaseException, identity: dict[str, Any]
 ) -> None:
     """Log a failed game, keep its traceback, and append a 'failed' line naming the seed
     and the cause."""

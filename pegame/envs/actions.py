@@ -13,12 +13,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from pegame.types import Body, Velocity
 
 
-def to_velocity(action: ArrayLike, body: Body, clip: bool = False, who: str = "action") -> Velocity:
+def to_velocity(action: object, body: Body, clip: bool = False, who: str = "action") -> Velocity:
     """The command for ``action`` (see the module docstring); ``who`` names it in errors."""
     try:
         a = action if isinstance(action, np.ndarray) else np.asarray(action, dtype=np.float64)

@@ -14,6 +14,7 @@ when the game's ``t_max`` is reached.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from gymnasium import spaces
@@ -37,7 +38,10 @@ class PursuitEvasionParallelEnv(ParallelEnv):
     ``"rgb_array"`` (``render()`` draws the game from above, :meth:`EnvGame.frame`).
     """
 
-    metadata = {"name": "pegame_pursuit_evasion_v0", "render_modes": list(RENDER_MODES)}
+    metadata: dict[str, Any] = {
+        "name": "pegame_pursuit_evasion_v0",
+        "render_modes": list(RENDER_MODES),
+    }
 
     def __init__(
         self,

@@ -198,8 +198,8 @@ class BatchedGame:
         opponent = self.opponent
         if opponent is None or opponent.table is not None:
             table = _NO_TABLE if opponent is None else opponent.table
-            role = -1 if opponent is None else opponent.role
-            kernels.play(self.world, rules, state, playing, self.ticks_per_action, table, role)
+            played = -1 if opponent is None else opponent.role
+            kernels.play(self.world, rules, state, playing, self.ticks_per_action, table, played)
         else:
             for _ in range(self.ticks_per_action):
                 live = playing & (state.steps < rules.ticks)
