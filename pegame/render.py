@@ -20,6 +20,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 from PIL import Image, ImageDraw
 
 from pegame.figures import _drawn_shades
@@ -77,7 +78,7 @@ class FrameRenderer:
         self.fov, self.near, self.far = fov, near, far
         self.radii = (pursuer_radius, evader_radius)
 
-    def pixel(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def pixel(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
         """Map-frame points (m) -> (n, 2) pixel coordinates (column, row from the top)."""
         ox, oy, yaw = self.origin
         dx, dy = np.asarray(x, dtype=float) - ox, np.asarray(y, dtype=float) - oy

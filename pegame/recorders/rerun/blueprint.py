@@ -45,15 +45,14 @@ def blueprint(grid, camera, has_image: bool) -> rrb.Blueprint:
             for timeline in (STEP, SIM_TIME)
         ]
     )
-    trails = {f"world/{name}/trajectory": so_far for name in ("pursuer", "evader")}
     map_view = rrb.Spatial3DView(
         origin="world",
         name="Map",
         eye_controls=eye,
         line_grid=rrb.LineGrid3D(visible=False),
-        overrides=trails,
+        overrides={f"world/{name}/trajectory": so_far for name in ("pursuer", "evader")},
     )
-    side = [
+    side: list[rrb.Container | rrb.View] = [
         rrb.TimeSeriesView(
             origin="plots/tracking", name="Tracking", axis_y=rrb.ScalarAxis(range=(0.0, 1.05))
         ),

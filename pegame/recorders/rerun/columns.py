@@ -12,7 +12,7 @@ arrays in the map frame (m).
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 import pyarrow as pa
@@ -75,6 +75,13 @@ def row_columns(rows: list[tuple]) -> dict[str, np.ndarray]:
     return dict(zip(ROW, np.array(rows, dtype=float).T))
 
 
+class Archetype(Protocol):
+    """A Rerun archetype class (``rr.Points3D``, ...): ``columns(**components)`` gives its
+    component columns for send_columns."""
+
+    def columns(self, *args: Any, **kwargs: Any) -> Any: ...
+
+
 class EntityBuffer:
     """Rows of one entity waiting to be sent with ``send_columns``.
 
@@ -83,7 +90,7 @@ class EntityBuffer:
     n (K, 3) arrays. ``kind`` is the archetype (``rr.Points3D``, ``rr.TextLog``, ...).
     """
 
-    def __init__(self, path: str, kind: type) -> None:
+    def __init__(self, path: str, kind: Archetype) -> None:
         self.path, self.kind = path, kind
         self.steps: list[int] = []
         self.times: list[float] = []

@@ -224,6 +224,6 @@ def _headings(
         moved = np.diff(xy, axis=0, prepend=xy[:1])
         direction = np.arctan2(moved[:, 1], moved[:, 0])
         still = np.hypot(moved[:, 0], moved[:, 1]) < 1e-9
-        for i in np.flatnonzero(missing):
+        for i in np.flatnonzero(missing).tolist():
             theta[i] = theta[i - 1] if still[i] and i > 0 else direction[i]
     return np.nan_to_num(theta)

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 import rerun as rr
 
-from pegame.api import Recorder, Tick
+from pegame.api import Context, Recorder, Tick
 from pegame.errors import ResultsWriteError, require
 from pegame.files import make_dir, write_atomic
 from pegame.recorders.files import COMPLETE, FAILED, PARTIAL, recording_path
@@ -117,7 +117,7 @@ class RerunRecorder(Recorder):
         "Rerun recording per game (<game_id>.rrd): map, agents, FOV, belief, plans, plots."
     )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         self.path: Path | None = None  # the recording's file: partial, then complete or failed
         self._game: tuple[Path, str] | None = None  # (out_dir, game_id)
@@ -189,7 +189,7 @@ class RerunRecorder(Recorder):
         self._rec = rec
         # Wall-clock time would only make recordings of one game differ from run to run.
         rr.set_log_time_enabled(False, recording=rec)
-        self._stream = rec.binary_stream()
+        self._stream = rr.binary_stream(recording=rec)
         if self.config.spawn:
             rr.spawn(connect=False)
             rec.set_sinks(rr.GrpcSink(), self._stream)
@@ -203,10 +203,12 @@ class RerunRecorder(Recorder):
             text = "game over" + (f": tracking rate {100 * rate:.1f}%" if rate is not None else "")
             buffer_event(self._buffers, self._last.step, self._last.time, text)
         self._flush(final=True)
-        send_property(self._rec, "result", flat_config(result))
+        rec, game = self._rec, self._game
+        assert rec is not None and game is not None  # finish returns early without them
+        send_property(rec, "result", flat_config(result))
         self._close(COMPLETE)
         # A failed copy of this game from an earlier run is superseded by this one.
-        recording_path(*self._game, FAILED).unlink(missing_ok=True)
+        recording_path(*game, FAILED).unlink(missing_ok=True)
 
     def _abort(self, error: BaseException) -> None:
         step, time = (self._last.step, self._last.time) if self._last is not None else (0, 0.0)
@@ -215,8 +217,10 @@ class RerunRecorder(Recorder):
             self._buffers, step, time, f"game failed after step {step}: {described}", "ERROR"
         )
         self._flush(final=True)
+        rec = self._rec
+        assert rec is not None  # abort returns early without a recording
         send_property(
-            self._rec,
+            rec,
             "failure",
             {"error": type(error).__name__, "message": str(error), "step": step},
         )
@@ -227,6 +231,7 @@ class RerunRecorder(Recorder):
         the partial name. ResultsWriteError naming the file when rerun-sdk does not
         deliver them or the write fails; no file is left then."""
         rec, stream, self._rec, self._stream = self._rec, self._stream, None, None
+        assert rec is not None and stream is not None and self._game is not None  # started
         final = recording_path(*self._game, status)
         try:
             data = stream.read(flush=True, flush_timeout_sec=FLUSH_TIMEOUT)
@@ -257,9 +262,11 @@ class RerunRecorder(Recorder):
     def _log(self, tick: Tick) -> None:
         """Buffer the tick: its numbers as one row, its variable-size data (particles,
         plans, events) in buffers; images are logged at once."""
+        rec = self._rec
+        assert rec is not None  # log returns early without a recording
         if self._last is None:
             has_image = tick.frame.rgb is not None
-            self._rec.send_blueprint(blueprint(self.context.grid, self.context.camera, has_image))
+            rec.send_blueprint(blueprint(self.context.grid, self.context.camera, has_image))
         self._last = tick
         self._detections += tick.detection is not None
         self._rows.append(tick_row(tick, self._detections / (tick.step + 1)))
@@ -270,7 +277,7 @@ class RerunRecorder(Recorder):
         buffer_team(self._buffers, tick, self.context, self.config.max_particles)
         every = self.config.image_every
         if tick.frame.rgb is not None and every and tick.step % every == 0:
-            log_image(self._rec, tick, self.context.camera, self.config.jpeg_quality)
+            log_image(rec, tick, self.context.camera, self.config.jpeg_quality)
         if (tick.step + 1) % self._flush_every == 0:
             self._flush()
 
@@ -313,7 +320,8 @@ class RerunRecorder(Recorder):
         """Send the buffered rows and buffers (``final``: the game's last ones), one
         ``log_<family>`` of :mod:`.scene` per entity tree. The file is written by
         rerun-sdk's own thread meanwhile; a write error surfaces when the file is closed."""
-        rec, indexes = self._rec, {}
+        rec, indexes = self._rec, dict[bytes, list]()
+        assert rec is not None  # flushed only while recording
         if self._rows:
             c = row_columns(self._rows)
             self._rows = []

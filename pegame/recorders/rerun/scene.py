@@ -25,6 +25,7 @@ from pegame.grid import per_grid
 from pegame.recorders.rerun.columns import (
     SIM_TIME,
     STEP,
+    Archetype,
     EntityBuffer,
     ParticleRows,
     points_at,
@@ -284,7 +285,13 @@ class Buffers(dict):
     """The :class:`EntityBuffer` of each entity path with rare rows (plans, events)."""
 
     def add(
-        self, path: str, kind: type, step: int, time: float, create: bool = True, **values
+        self,
+        path: str,
+        kind: Archetype,
+        step: int,
+        time: float,
+        create: bool = True,
+        **values: Any,
     ) -> None:
         """Buffer one row of ``kind`` at ``path``; with create=False only for an entity
         that already exists (an empty row then clears what it showed)."""
@@ -331,11 +338,12 @@ def log_image(rec: rr.RecordingStream, tick: Tick, camera: Camera, jpeg_quality:
     rec.set_time(STEP, sequence=tick.step)
     rec.set_time(SIM_TIME, duration=tick.time)
     rgb = tick.frame.rgb
+    assert rgb is not None  # logged for the frames that have an image only
     size = (camera.image_width, camera.image_height)
     if rgb.shape[1::-1] != size:
         # Detections are in the camera's image_width x image_height pixel frame; a
         # simulator may render smaller, so the image is scaled to that frame.
         from PIL import Image
 
-        rgb = np.asarray(Image.fromarray(rgb).resize(size, Image.BILINEAR))
+        rgb = np.asarray(Image.fromarray(rgb).resize(size, Image.Resampling.BILINEAR))
     rec.log("camera/image", rr.Image(rgb).compress(jpeg_quality=jpeg_quality), strict=True)
