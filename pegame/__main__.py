@@ -153,6 +153,25 @@ def _app(cfg: DictConfig) -> int:
     return status
 
 
+def report_broken_sweep(sweep_dir: Path, error: BaseException | None) -> None:
+    """After the launcher stopped a multirun (a worker process died): the report of the
+    games stored so far, and one paragraph saying what happened and how to complete it."""
+    from pegame.report import write_report
+
+    try:
+        write_report(sweep_dir)
+        written = f"the report of the games stored so far is in {sweep_dir}"
+    except Exception as exc:
+        written = f"no report could be written ({exc})"
+    print(
+        f"pegame: error: the launcher stopped the sweep ({type(error).__name__}: a worker "
+        f"process died, e.g. killed or out of memory); the jobs it ran and those not yet "
+        f"started did not finish; {written}. Run the sweep again with resume=true to "
+        f"complete it.",
+        file=sys.stderr,
+    )
+
+
 def _terminate(signum: int, frame: object) -> None:
     raise KeyboardInterrupt  # SIGTERM unwinds like Ctrl-C: the launcher stops its workers
 
@@ -170,7 +189,11 @@ def main() -> None:
     except SystemExit as exc:
         if exc.code == 1 and isinstance(exc.__context__, (HydraException, OmegaConfBaseException)):
             sys.exit(sweep.BAD_INPUT)  # Hydra reported (and exited on) a bad command line
-        raise
+        broken = sweep.end_broken_sweep() if exc.code == 1 else None
+        if broken is None:
+            raise
+        report_broken_sweep(broken, exc.__context__)
+        sys.exit(sweep.GAMES_FAILED)
     except PegameError as exc:
         print(f"pegame: error: {exc}", file=sys.stderr)  # before Hydra: no job log yet
         sys.exit(sweep.BAD_INPUT)

@@ -93,7 +93,10 @@ def check_choices(kind: str, values: Sequence[str]) -> None:
 
 def check_key(key: str) -> None:
     """ConfigError for a dotted ``key`` that names no top-level node or no field of a
-    fixed node (plugin nodes' keys are their plugin's, checked when the game is built)."""
+    fixed node (plugin nodes' keys are their plugin's, checked when the game is built;
+    Hydra's own keys and config groups such as ``hydra/launcher`` are Hydra's)."""
+    if "/" in key or key.split(".", 1)[0] == "hydra":
+        return
     top, _, rest = key.partition(".")
     allowed = [f.name for f in fields(Schema)]
     if top not in allowed and top != "hydra":

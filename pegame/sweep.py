@@ -156,6 +156,19 @@ def end_sweep() -> int:
     return max(statuses)
 
 
+def end_broken_sweep() -> Path | None:
+    """After Hydra stopped a multirun with an error (joblib's TerminatedWorkerError when a
+    worker process died: the launcher cancels every job it had not finished): end the sweep
+    as :func:`end_sweep` does, with at least status 1 (jobs did not finish), and return its
+    directory; None when no sweep of this process is open."""
+    directory = os.environ.get(STATUS_DIR_ENV)
+    if directory is None:
+        return None
+    end_sweep()
+    record(GAMES_FAILED)
+    return Path(directory).parent
+
+
 def sweep_parent() -> int | None:
     """The sweep process's PID when this process is one of its worker processes (a direct
     child, as loky and submitit-local workers are), else None: a single run or a job run

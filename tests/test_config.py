@@ -195,5 +195,12 @@ def test_added_keys_and_deletions_are_left_to_hydra_and_the_schema():
     from pegame.overrides import check_overrides
 
     check_overrides(
-        ["+game.extra=1", "~recorder", "++resume=true", "hydra.run.dir=x", "pursuer.k_v=1"]
+        [
+            "+game.extra=1",
+            "~recorder",
+            "++resume=true",
+            "hydra.run.dir=x",
+            "hydra/launcher=joblib",
+            "pursuer.k_v=1",
+        ]
     )

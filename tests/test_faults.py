@@ -290,3 +290,46 @@ def test_a_results_file_with_bytes_that_are_no_utf8_still_resumes(tmp_path):
         handle.write(b'{"kind": "summ\xffary"}\n\xfe\xff\n[1, 2]\n"text"\n')  # no UTF-8, no object
     resumed = compose([*FAST, "game.trials=3", "resume=true", *RANDOM])
     assert [r["seed"] for r in job.run_job(resumed, tmp_path).played] == [2]
+
+
+# --- a worker killed -----------------------------------------------------------------
+
+
+def workers_of(pid: int) -> list[int]:
+    """The live child processes of ``pid`` that run pegame jobs (loky's workers)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+            command = (stat.parent / "cmdline").read_bytes()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and fields[0] != "Z" and b"popen_loky" in command:
+            found.append(int(stat.parent.name))
+    return found
+
+
+@pytest.mark.slow
+def test_a_killed_worker_ends_the_sweep_with_a_report_of_what_finished_and_exit_1(tmp_path):
+    # joblib's TerminatedWorkerError ended the sweep with exit 1, no report, no word on resume
+    sweep = tmp_path / "sweep"
+    args = [
+        "-m", "recorder=none", "env=hall", "game.t_max=4", "game.trials=60",
+        "pursuer=random", "evader=random,smart", "hydra.launcher.n_jobs=2",
+        f"hydra.sweep.dir={sweep}",
+    ]  # fmt: skip
+    proc = app(tmp_path, *args, env={"PYTHONUNBUFFERED": "1"})
+    for line in proc.stdout:  # a job prints each game's line once it is stored
+        if " on hall: tracking rate " in line:
+            break
+    victims = workers_of(proc.pid)
+    assert victims, "no loky worker found"
+    os.kill(victims[0], 9)
+    status, err = finished(proc)
+    assert status == 1, err
+    assert "a worker process died" in err and "resume=true" in err
+    assert (sweep / "report.json").is_file() and (sweep / "table1.md").is_file()
+    assert not list(sweep.glob(".pegame-status-*"))
+    status, err = run(tmp_path, *args, "resume=true")  # the sweep's owner let it go
+    assert status == 0, err
+    assert len(games(sweep)) == 120

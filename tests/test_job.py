@@ -6,10 +6,11 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import select
 import signal
 import subprocess
 import sys
-import time
+import threading
 from pathlib import Path
 
 import pytest
@@ -210,9 +211,11 @@ SWEEP = [
 
 
 def start_sweep(tmp_path: Path, *extra: str, sigint_ignored: bool = False) -> subprocess.Popen:
-    """The interrupt tests' sweep; ``sigint_ignored``: start it with SIGINT ignored, as a
-    background job or a test runner's worker would."""
+    """The interrupt tests' sweep, its stdout (one summary line per game, unbuffered in
+    every process) and stderr piped; ``sigint_ignored``: start it with SIGINT ignored, as
+    a background job or a test runner's worker would."""
     env = {k: v for k, v in os.environ.items() if k != "HYDRA_FULL_ERROR"}
+    env["PYTHONUNBUFFERED"] = "1"
     ignore = (lambda: signal.signal(signal.SIGINT, signal.SIG_IGN)) if sigint_ignored else None
     return subprocess.Popen(
         [
@@ -225,8 +228,9 @@ def start_sweep(tmp_path: Path, *extra: str, sigint_ignored: bool = False) -> su
             *extra,
         ],
         cwd=tmp_path,
-        stdout=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
+        text=True,
         env=env,
         start_new_session=True,
         preexec_fn=ignore,
@@ -239,55 +243,66 @@ def games_stored(tmp_path: Path) -> list[int]:
 
 
 def children(pid: int) -> list[int]:
-    """Live (not zombie) processes whose parent is ``pid``."""
+    """Live (not zombie) loky worker processes whose parent is ``pid`` (not loky's
+    resource tracker, which runs no job)."""
     found = []
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
             fields = stat.read_text().rsplit(")", 1)[1].split()
+            command = (stat.parent / "cmdline").read_bytes()
         except OSError:
             continue
-        if int(fields[1]) == pid and fields[0] != "Z":
+        if int(fields[1]) == pid and fields[0] != "Z" and b"popen_loky" in command:
             found.append(int(stat.parent.name))
     return found
 
 
-def alive(pid: int) -> bool:
+def wait_for_games(proc: subprocess.Popen, per_job: int) -> None:
+    """Block until both jobs of the sweep printed ``per_job`` games: a job prints a game's
+    summary line after storing it, so this waits on the sweep's own output, not on time.
+    The rest of the output is drained by a thread, so that no worker blocks on the pipe."""
+    seen: dict[str, int] = {}
+    while len(seen) < 2 or min(seen.values()) < per_job:
+        line = proc.stdout.readline()
+        if not line:
+            pytest.fail(f"the sweep ended before playing: {proc.stderr.read()}")
+        if " on hall: tracking rate " in line:
+            pairing = line.split(" ", 1)[0]
+            seen[pairing] = seen.get(pairing, 0) + 1
+    threading.Thread(target=proc.stdout.read, daemon=True).start()
+
+
+def wait_exit(pid: int, timeout: float = 300) -> bool:
+    """Block until process ``pid`` has exited (its pidfd turns readable; the timeout only
+    keeps a broken run from hanging the suite); whether it did."""
     try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except OSError:
-        return False
-    return state != "Z"
+        fd = os.pidfd_open(pid)
+    except ProcessLookupError:
+        return True
+    try:
+        readable, _, _ = select.select([fd], [], [], timeout)
+        return bool(readable)
+    finally:
+        os.close(fd)
 
 
 def interrupt_mid_sweep(tmp_path: Path, how, sigint_ignored: bool = False) -> list[int]:
     """Start a two-worker joblib sweep, wait until both jobs stored games, interrupt it with
     ``how(proc)``; return the worker PIDs it had."""
     proc = start_sweep(tmp_path, sigint_ignored=sigint_ignored)
-    deadline = time.monotonic() + 240
-    while time.monotonic() < deadline:
-        counts = games_stored(tmp_path)
-        if len(counts) == 2 and min(counts) >= 2:
-            break
-        assert proc.poll() is None, proc.stderr.read().decode()
-        time.sleep(0.2)
-    else:
-        pytest.fail("the sweep stored no games in time")
+    wait_for_games(proc, per_job=2)
     workers = children(proc.pid)
     assert len(workers) >= 2
     how(proc)
-    proc.wait(timeout=60)
+    proc.wait(timeout=300)
     return workers
 
 
 def assert_workers_stop(tmp_path: Path, workers: list[int]) -> None:
-    deadline = time.monotonic() + 15  # a game here takes well under a second
-    while any(alive(pid) for pid in workers) and time.monotonic() < deadline:
-        time.sleep(0.2)
-    assert not [pid for pid in workers if alive(pid)], "workers outlived the sweep"
-    stopped = games_stored(tmp_path)
-    assert sum(stopped) < 2 * TRIALS
-    time.sleep(1.0)
-    assert games_stored(tmp_path) == stopped  # nothing appends any more
+    """Every worker exits (within one game: they check between games that the sweep's
+    process lives), so nothing can append any more, and the sweep stopped short."""
+    assert all(wait_exit(pid) for pid in workers), "workers outlived the sweep"
+    assert sum(games_stored(tmp_path)) < 2 * TRIALS
 
 
 @pytest.mark.slow
@@ -296,7 +311,7 @@ def test_kill_9_of_the_sweep_parent_stops_its_workers_and_resume_completes(tmp_p
     assert_workers_stop(tmp_path, workers)
     resumed = start_sweep(tmp_path, "resume=true")
     _, err = resumed.communicate(timeout=600)
-    assert resumed.returncode == 0, err.decode()
+    assert resumed.returncode == 0, err
     for path in sorted((tmp_path / "sweep").glob("*/results.jsonl")):
         seeds = [e["seed"] for e in job.read_lines(path) if e.get("kind") == "game"]
         assert sorted(seeds) == list(range(TRIALS)), path  # every game once: no race, none lost
@@ -306,7 +321,7 @@ def test_kill_9_of_the_sweep_parent_stops_its_workers_and_resume_completes(tmp_p
 def test_sigterm_of_the_sweep_parent_stops_its_workers(tmp_path):
     def terminate(proc):
         proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=60) == 130
+        assert proc.wait(timeout=300) == 130
 
     workers = interrupt_mid_sweep(tmp_path, terminate)
     assert_workers_stop(tmp_path, workers)
@@ -319,7 +334,7 @@ def test_ctrl_c_stops_the_sweep_and_its_workers(tmp_path, sigint_ignored):
     # runner's worker) ran to the end and exited 0 on an interrupt
     def ctrl_c(proc):
         os.killpg(proc.pid, signal.SIGINT)  # the terminal signals the whole foreground group
-        assert proc.wait(timeout=60) == 130
+        assert proc.wait(timeout=300) == 130
 
     workers = interrupt_mid_sweep(tmp_path, ctrl_c, sigint_ignored)
     assert_workers_stop(tmp_path, workers)
