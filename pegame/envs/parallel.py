@@ -48,7 +48,7 @@ class PursuitEvasionParallelEnv(ParallelEnv):
         config: DictConfig | None = None,
         overrides: Sequence[str] = (),
         render_mode: str | None = None,
-        **settings,
+        **settings: Any,
     ) -> None:
         self.settings = env_settings(**settings)
         self.render_mode = check_render_mode(render_mode)
@@ -74,7 +74,9 @@ class PursuitEvasionParallelEnv(ParallelEnv):
     def action_space(self, agent: str) -> spaces.Box:
         return self.action_spaces[agent]
 
-    def reset(self, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
         """Start a game. ``seed`` re-seeds the env: the game with master seed ``seed``, and
         later seedless resets draw their seeds from it; never seeded, seeds are random."""
         if seed is not None or self._np_random is None:
@@ -83,7 +85,15 @@ class PursuitEvasionParallelEnv(ParallelEnv):
         self.agents = list(self.possible_agents)
         return obs, {agent: {"seed": self.game.seed} for agent in self.agents}
 
-    def step(self, actions: dict[str, np.ndarray]):
+    def step(
+        self, actions: dict[str, np.ndarray]
+    ) -> tuple[
+        dict[str, np.ndarray],
+        dict[str, float],
+        dict[str, bool],
+        dict[str, bool],
+        dict[str, dict[str, object]],
+    ]:
         """One decision period with every agent's action (ValueError for a bad one)."""
         obs, reward, done = self.game.step(actions)
         rewards = dict.fromkeys(self.game.members["pursuer"], reward)
@@ -107,7 +117,7 @@ def parallel_env(
     config: DictConfig | None = None,
     overrides: Sequence[str] = (),
     render_mode: str | None = None,
-    **settings,
+    **settings: Any,
 ) -> PursuitEvasionParallelEnv:
     """The PettingZoo Parallel environment (see :class:`PursuitEvasionParallelEnv`)."""
     return PursuitEvasionParallelEnv(config, overrides, render_mode, **settings)

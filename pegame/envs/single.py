@@ -10,7 +10,7 @@ infos and episode length: :mod:`pegame.envs.core`; the end of the game is a trun
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import gymnasium
 import numpy as np
@@ -40,7 +40,7 @@ class _SingleAgentEnv(gymnasium.Env):
 
     role: ClassVar[str]
     env_id: ClassVar[str]
-    metadata = {"render_modes": list(RENDER_MODES)}
+    metadata: dict[str, Any] = {"render_modes": list(RENDER_MODES)}
 
     def __init__(
         self,
@@ -48,7 +48,7 @@ class _SingleAgentEnv(gymnasium.Env):
         overrides: Sequence[str] = (),
         opponent: str | None = None,
         render_mode: str | None = None,
-        **settings,
+        **settings: Any,
     ) -> None:
         self.settings = env_settings(**settings)
         self.render_mode = check_render_mode(render_mode)
@@ -70,14 +70,16 @@ class _SingleAgentEnv(gymnasium.Env):
         self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
         self._sign = 1.0 if self.role == "pursuer" else -1.0
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         """Start a game; ``seed`` is the game's master seed (later seedless resets draw
         theirs from it); never seeded, seeds are random."""
         super().reset(seed=check_seed(seed))
         obs = self.game.reset(game_seed(seed, self.np_random))
         return obs[self.role], {"seed": self.game.seed}
 
-    def step(self, action):
+    def step(self, action: object) -> tuple[np.ndarray, float, bool, bool, dict[str, object]]:
         """One decision period (ValueError for a bad action)."""
         obs, reward, done = self.game.step({self.role: action})
         return obs[self.role], self._sign * reward, False, done, self.game.info()

@@ -26,7 +26,7 @@ summed tick by tick (:mod:`pegame.vector.metrics`).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal, overload
 
 import numpy as np
@@ -34,6 +34,7 @@ from gymnasium import spaces
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
+from numpy.typing import ArrayLike
 from omegaconf import DictConfig
 
 from pegame.envs.core import check_seed
@@ -41,6 +42,9 @@ from pegame.envs.settings import env_config, env_settings
 from pegame.errors import ConfigError
 from pegame.loop import ROLES
 from pegame.vector import BatchedGame
+
+#: the seeds a batched env's reset takes: one for game 0 (the others follow), one per game
+Seeds = int | Sequence[int | None] | None
 
 #: the ``role`` values of :func:`vector_env`: one learner, or both (self-play)
 VECTOR_ROLES = ("pursuer", "evader", "both")
@@ -53,7 +57,15 @@ class _Batch:
     #: gymnasium's VectorEnv._add_info, which each batched env has
     _add_info: Callable[[dict[str, Any], dict[str, Any], int], dict[str, Any]]
 
-    def _setup(self, num_envs, config, overrides, opponents, roles, settings) -> None:
+    def _setup(
+        self,
+        num_envs: int,
+        config: DictConfig | None,
+        overrides: Sequence[str],
+        opponents: dict[str, str] | None,
+        roles: Sequence[str],
+        settings: dict[str, Any],
+    ) -> None:
         self.settings = env_settings(**settings)
         cfg = env_config(config, overrides, opponents)
         self.game = BatchedGame(cfg, self.settings, roles, num_envs)
@@ -69,11 +81,13 @@ class _Batch:
         features = self.game.features[role]
         return spaces.Box(features.low, features.high, dtype=np.float32)
 
-    def _seeds(self, seed) -> list[int | None]:
+    def _seeds(self, seed: Seeds) -> list[int | None]:
         """Per-game seeds as SyncVectorEnv.reset takes them."""
         if seed is None:
             return [None] * self.num_envs
-        if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+        if isinstance(seed, bool):
+            raise ValueError(f"seed must be None, an integer or a list of seeds, got {seed!r}.")
+        if isinstance(seed, (int, np.integer)):
             return [check_seed(int(seed)) + i for i in range(self.num_envs)]
         seeds = list(seed)
         if len(seeds) != self.num_envs:
@@ -93,13 +107,15 @@ class _Batch:
             out.append(int(self._rngs[game].integers(2**63 - 1)) if seed is None else int(seed))
         return out
 
-    def _reset(self, seed, options) -> None:
+    def _reset(self, seed: Seeds, options: dict[str, Any] | None) -> None:
         seeds = self._seeds(seed)
         self.game.reset_games(self._all, self._game_seeds(self._all, seeds))
         self._autoreset[:] = False
         self._started = True
 
-    def _commands(self, actions, playing: np.ndarray) -> dict[str, np.ndarray]:
+    def _commands(
+        self, actions: Mapping[str, ArrayLike], playing: np.ndarray
+    ) -> dict[str, np.ndarray]:
         """role -> (N, 2) (v, w) of the learners' batched ``actions`` (role -> (N, 2) in
         [-1, 1]); ValueError for a bad one among the games playing."""
         out = {}
@@ -128,7 +144,9 @@ class _Batch:
             out[role] = a * np.array([body.v_max, body.w_max])
         return out
 
-    def _advance(self, actions) -> tuple[np.ndarray, np.ndarray, dict]:
+    def _advance(
+        self, actions: Mapping[str, ArrayLike]
+    ) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
         """Step the playing games, reset the ones that ended last step (NEXT_STEP).
         Returns the rewards, the games that ended and the infos."""
         if not self._started:
@@ -175,7 +193,7 @@ class _LearnerVectorEnv(_Batch, VectorEnv):
         config: DictConfig | None = None,
         overrides: Sequence[str] = (),
         opponent: str | None = None,
-        **settings,
+        **settings: Any,
     ) -> None:
         other = "evader" if self.role == "pursuer" else "pursuer"
         opponents = {other: opponent} if opponent is not None else None
@@ -188,13 +206,17 @@ class _LearnerVectorEnv(_Batch, VectorEnv):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._sign = 1.0 if self.role == "pursuer" else -1.0
 
-    def reset(self, *, seed: int | list[int | None] | None = None, options: dict | None = None):
+    def reset(
+        self, *, seed: Seeds = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         """Start a game in every env; ``seed`` as ``SyncVectorEnv.reset`` takes it."""
         self._reset(seed, options)
         infos = self._seed_info({}, np.ones(self.num_envs, np.bool_))
         return self.game.observations(self.role), infos
 
-    def step(self, actions):
+    def step(
+        self, actions: ArrayLike
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """One decision period of every game ((N, 2) actions; ValueError for a bad one)."""
         rewards, ended, infos = self._advance({self.role: actions})
         return (
@@ -205,7 +227,7 @@ class _LearnerVectorEnv(_Batch, VectorEnv):
             infos,
         )
 
-    def close_extras(self, **kwargs) -> None:
+    def close_extras(self, **kwargs: Any) -> None:
         """Nothing to release: the games hold no simulator processes."""
 
 
@@ -241,7 +263,7 @@ class SelfPlayVectorEnv(_Batch):
         num_envs: int,
         config: DictConfig | None = None,
         overrides: Sequence[str] = (),
-        **settings,
+        **settings: Any,
     ) -> None:
         self._setup(num_envs, config, overrides, None, ROLES, settings)
         self.possible_agents = list(ROLES)
@@ -261,12 +283,22 @@ class SelfPlayVectorEnv(_Batch):
     def _observations(self) -> dict[str, np.ndarray]:
         return {role: self.game.observations(role) for role in ROLES}
 
-    def reset(self, *, seed=None, options: dict | None = None):
+    def reset(
+        self, *, seed: Seeds = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         """Start a game in every env; ``seed`` as the vector envs take it."""
         self._reset(seed, options)
         return self._observations(), self._seed_info({}, np.ones(self.num_envs, np.bool_))
 
-    def step(self, actions: dict[str, np.ndarray]):
+    def step(
+        self, actions: dict[str, np.ndarray]
+    ) -> tuple[
+        dict[str, np.ndarray],
+        dict[str, np.ndarray],
+        dict[str, np.ndarray],
+        dict[str, np.ndarray],
+        dict[str, Any],
+    ]:
         """One decision period of every game with both agents' (N, 2) actions."""
         if not isinstance(actions, dict) or sorted(actions) != sorted(ROLES):
             raise ValueError(f"actions must map each agent in {list(ROLES)} to its (N, 2) actions.")

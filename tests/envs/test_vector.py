@@ -188,6 +188,14 @@ def test_make_vec_builds_the_batched_env():
     assert play_side_by_side(batched, synced, 5, 25, np.random.default_rng(9)) == 3
 
 
+def test_a_boolean_seed_is_a_clear_error():
+    """True is an int to Python; as a seed it was iterated (a TypeError), as the single
+    envs refuse it with a ValueError."""
+    env = vector_env(2, overrides=SHORT + ["evader.model=action"], opponent="random")
+    with pytest.raises(ValueError, match="got True"):
+        env.reset(seed=True)
+
+
 def test_bad_actions_and_unsupported_configs_are_clear_errors():
     env = vector_env(2, overrides=SHORT + ["evader.model=action"], opponent="random")
     with pytest.raises(RuntimeError, match="reset"):

@@ -12,10 +12,12 @@ import math
 import numpy as np
 import rerun.blueprint as rrb
 
+from pegame.grid import OccupancyGrid
 from pegame.recorders.rerun.columns import SIM_TIME, STEP
+from pegame.types import Camera
 
 
-def blueprint(grid, camera, has_image: bool) -> rrb.Blueprint:
+def blueprint(grid: OccupancyGrid, camera: Camera, has_image: bool) -> rrb.Blueprint:
     """The default layout for a game on ``grid`` (its map-frame bounds place the eye)
     seen by ``camera``; has_image: whether the simulator renders camera images."""
     ox, oy, yaw = grid.origin

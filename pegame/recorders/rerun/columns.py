@@ -12,11 +12,13 @@ arrays in the map frame (m).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any, Protocol
 
 import numpy as np
 import pyarrow as pa
 import rerun as rr
+from numpy.typing import ArrayLike
 
 from pegame.api import Tick
 
@@ -97,7 +99,7 @@ class EntityBuffer:
         self.sizes: list[int] = []
         self.values: dict[str, list] = {}
 
-    def add(self, step: int, time: float, **values) -> None:
+    def add(self, step: int, time: float, **values: Any) -> None:
         self.steps.append(step)
         self.times.append(time)
         self.sizes.append(len(next(iter(values.values()))))
@@ -136,7 +138,7 @@ def time_index(cache: dict, steps: np.ndarray, times: np.ndarray) -> list:
     return cache[key]
 
 
-def strips_array(strips) -> pa.ListArray:
+def strips_array(strips: np.ndarray | Sequence[np.ndarray]) -> pa.ListArray:
     """LineStrip3D arrow array of float32 strips: a list of (K, 3) arrays or an (n, K, 3)
     array. Built in one go: rerun-sdk's own conversion loops over the strips in Python."""
     if isinstance(strips, np.ndarray):
@@ -153,14 +155,14 @@ def strips_array(strips) -> pa.ListArray:
     return pa.ListArray.from_arrays(pa.array(offsets), points, type=strip_type)
 
 
-def stack_points(x: np.ndarray, y: np.ndarray, z) -> np.ndarray:
+def stack_points(x: np.ndarray, y: np.ndarray, z: np.ndarray | float) -> np.ndarray:
     """(n, 3) float32 points from coordinates (m); z is an array or one height."""
     out = np.empty((len(x), 3), dtype=np.float32)
     out[:, 0], out[:, 1], out[:, 2] = x, y, z
     return out
 
 
-def points_at(xy, z: float) -> np.ndarray:
+def points_at(xy: ArrayLike, z: float) -> np.ndarray:
     """(n, 3) float32 points at height z (m) from (n, 2) map-frame positions (m); copies."""
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
     return stack_points(xy[:, 0], xy[:, 1], z)

@@ -21,7 +21,7 @@ import rerun as rr
 import yaml
 
 from pegame.api import Context, Tick
-from pegame.grid import per_grid
+from pegame.grid import OccupancyGrid, per_grid
 from pegame.recorders.rerun.columns import (
     SIM_TIME,
     STEP,
@@ -76,7 +76,7 @@ def log_static(rec: rr.RecordingStream, context: Context, properties: dict[str, 
         rec.log(path, style, static=True)
 
 
-def grid_map(grid) -> rr.GridMap:
+def grid_map(grid: OccupancyGrid) -> rr.GridMap:
     """The occupancy grid as an ``rr.GridMap``: map-frame metres, RViz's map colours.
 
     GridMap draws its first data row at the top (highest y) and puts the lower-left
@@ -107,7 +107,7 @@ def fov_template(camera: Camera) -> np.ndarray:
 def styles(pursuer_radius: float, evader_radius: float) -> dict[str, Any]:
     """Static colours and sizes (m) of every entity, logged once."""
 
-    def faded(color, alpha=160):
+    def faded(color: tuple[int, ...], alpha: int = 160) -> tuple[int, ...]:
         return (*color[:3], alpha)
 
     step_after = rr.components.InterpolationMode.StepAfter
@@ -154,7 +154,7 @@ def styles(pursuer_radius: float, evader_radius: float) -> dict[str, Any]:
 # c: the buffered rows as columns named as in columns.ROW; every: their index columns.
 
 
-def _send(rec: rr.RecordingStream, path: str, index: list, columns) -> None:
+def _send(rec: rr.RecordingStream, path: str, index: list, columns: Any) -> None:
     rec.send_columns(path, indexes=index, columns=columns, strict=True)
 
 

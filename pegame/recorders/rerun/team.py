@@ -12,9 +12,11 @@ Positions are in the map frame (m).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import rerun as rr
+from numpy.typing import ArrayLike
 
 from pegame.api import Context, Tick
 from pegame.recorders.rerun.columns import points_at
@@ -41,7 +43,7 @@ def placed(points: np.ndarray, pose: Pose) -> np.ndarray:
     return np.column_stack((pose.x + c * x - s * y, pose.y + s * x + c * y))
 
 
-def _discs(positions, radius: float, color) -> dict:
+def _discs(positions: ArrayLike, radius: float, color: ArrayLike) -> dict[str, Any]:
     xy = np.asarray(positions, dtype=float).reshape(-1, 2)
     n = len(xy)
     return {
