@@ -131,7 +131,7 @@ def point_on(grid: OccupancyGrid, u: float, v: float) -> tuple[float, float]:
 CELL_COORDINATES = st.integers(-2, 52).map(lambda k: 0.5 * k) | st.floats(-2.0, 26.0)
 
 
-@settings(max_examples=150)
+@settings(max_examples=100)
 @given(rooms(), st.floats(0.0, 0.3), CELL_COORDINATES, CELL_COORDINATES, POSES, st.integers(1, 20))
 def test_sweep_kernel_equals_reference(
     grid: OccupancyGrid, radius: float, u: float, v: float, towards: Pose, n: int
