@@ -87,7 +87,7 @@ EXP_MAX = 709.0
 
 
 @njit(cache=True, error_model="numpy")  # no zero-division branch (2 - c > 0): vectorised
-def exps(x):
+def exps(x: np.ndarray) -> np.ndarray:
     """exp of every element of the float array ``x`` (fdlibm's algorithm, < 1 ulp), each
     at most EXP_MAX; 0 where it is below EXP_NORMAL_MIN (also -inf), where the exact value
     would be subnormal or below. Branch-free, so numba vectorises it."""
@@ -112,7 +112,7 @@ def exps(x):
 
 
 @njit(cache=True, inline="always")
-def sin_cos(angle):
+def sin_cos(angle: float) -> tuple[float, float]:
     """(sin, cos) of ``angle`` (rad), |angle| <= MAX_ANGLE, within 2^-52 of libm's."""
     quadrant = math.floor(angle * _TWO_OVER_PI + 0.5)
     r = (angle - quadrant * _PI_OVER_2_HIGH) - quadrant * _PI_OVER_2_LOW
@@ -127,7 +127,7 @@ def sin_cos(angle):
     return (c if swap else s) * sin_sign, (s if swap else c) * cos_sign
 
 
-def wrap_angles_reference(angles):
+def wrap_angles_reference(angles: np.ndarray | float) -> np.ndarray | float:
     """Angles (rad, array or scalar) wrapped to (-pi, pi] (module docstring): ``pi - ((pi -
     angles) mod 2 pi)`` with numpy's floored modulo; the definition that
     :func:`wrap_angle_kernel` follows."""
@@ -135,7 +135,7 @@ def wrap_angles_reference(angles):
 
 
 @njit(cache=True)
-def wrap_angle_kernel(angle):
+def wrap_angle_kernel(angle: float) -> float:
     """:func:`wrap_angles_reference` of one angle (rad), bit for bit, mostly without fmod
     (slow in libm).
 
@@ -158,7 +158,7 @@ def wrap_angle_kernel(angle):
 
 
 @vectorize(["float64(float64)"], cache=True)
-def wrap_angles(angles):
+def wrap_angles(angles: float) -> float:
     """Angles (rad, float64 array or scalar) wrapped to (-pi, pi]: :func:`wrap_angle_kernel`
     elementwise, so bit for bit :func:`wrap_angles_reference` (and about twice as fast)."""
     return wrap_angle_kernel(angles)
@@ -168,7 +168,7 @@ _SPLIT = 134217729.0  # 2^27 + 1, Veltkamp's splitting constant for float64
 
 
 @njit(cache=True, inline="always")
-def _square(x):
+def _square(x: float) -> tuple[float, float]:
     """(hi, lo) with hi + lo = x * x exactly (Dekker's product, no FMA)."""
     hi = x * x
     t = _SPLIT * x
@@ -179,7 +179,7 @@ def _square(x):
 
 
 @njit(cache=True, inline="always")
-def _product(x, y):
+def _product(x: float, y: float) -> tuple[float, float]:
     """(hi, lo) with hi + lo = x * y exactly (Dekker's product, no FMA)."""
     hi = x * y
     t = _SPLIT * x
@@ -193,7 +193,7 @@ def _product(x, y):
 
 
 @njit(cache=True)
-def hypot(x, y):
+def hypot(x: float, y: float) -> float:
     """``math.hypot(x, y)`` of CPython 3.10+, bit for bit (module docstring), unless the
     larger magnitude is subnormal (below 2.2e-308 m: no game has such lengths)."""
     x, y = abs(x), abs(y)
@@ -228,7 +228,7 @@ def hypot(x, y):
 
 
 @njit(cache=True)
-def wrap_angle(angle):
+def wrap_angle(angle: float) -> float:
     """:func:`pegame.types.wrap_angle` (rad, onto (-pi, pi]), bit for bit."""
     period = 2.0 * math.pi
     if abs(angle) <= math.pi:
@@ -249,12 +249,12 @@ _NAIVE_ERROR = 1e-12
 
 
 @njit(cache=True, inline="always")
-def _margin(value):
+def _margin(value: float) -> float:
     return _NAIVE_ERROR * (abs(value) + 1.0)
 
 
 @njit(cache=True)
-def ceil_of_hypot(x, y, res):
+def ceil_of_hypot(x: float, y: float, res: float) -> int:
     """``math.ceil(2 * hypot(x, y) / res)`` (res > 0) of Python's hypot (the grid
     simulator's sample count), from the plain sqrt(x * x + y * y) unless a whole number
     lies within its error bound."""
@@ -266,7 +266,7 @@ def ceil_of_hypot(x, y, res):
 
 
 @njit(cache=True)
-def hypot_within(x, y, low, high):
+def hypot_within(x: float, y: float, low: float, high: float) -> bool:
     """``low <= hypot(x, y) <= high`` of Python's hypot, from the plain sqrt(x * x + y * y)
     unless it lies within its error bound of low or high."""
     naive = math.sqrt(x * x + y * y)
@@ -283,7 +283,9 @@ _NEAR_HALF = 0.5 - 2.0**-20
 
 
 @njit(cache=True, inline="always")
-def cell_by_product(u, v, inverse, height, width):
+def cell_by_product(
+    u: float, v: float, inverse: float, height: int, width: int
+) -> tuple[int, bool]:
     """(1 + the flat index of the cell (floor(v / res), floor(u / res)) of a grid of
     ``height`` x ``width`` cells, or 0 off the grid; decided) for the grid-frame point
     (u, v) (m), from the products by ``inverse`` = 1 / res.
@@ -311,7 +313,7 @@ def cell_by_product(u, v, inverse, height, width):
 
 
 @njit(cache=True, inline="always")
-def cell_by_division(u, v, res, height, width):
+def cell_by_division(u: float, v: float, res: float, height: int, width: int) -> int:
     """:func:`cell_by_product`'s cell from the division itself (``world_to_cell``): a
     quotient in [0, n) is a cell floor(q) in [0, n), and there truncation floors."""
     qc, qr = u / res, v / res

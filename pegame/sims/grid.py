@@ -17,12 +17,14 @@ plain-Python loop it reproduces, which the tests compare it against.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
 from numba import njit
 
-from pegame.api import Simulator
-from pegame.grid import cell_blocked, point_cell
+from pegame.api import Context, Simulator
+from pegame.grid import OccupancyGrid, cell_blocked, point_cell
 from pegame.navigation import shared_inflation
 from pegame.types import STOP, Body, Pose, SensorFrame, Velocity, clamp, wrap_angle
 
@@ -63,7 +65,9 @@ def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
 
 
 @njit(cache=True)
-def _sweep(blocked, sx, sy, tx, ty, n, frame):
+def _sweep(
+    blocked: np.ndarray, sx: float, sy: float, tx: float, ty: float, n: int, frame: tuple
+) -> tuple[float, float]:
     """The last of the points k/n along the chord from (sx, sy) to (tx, ty) (m, map frame),
     k = 1..n, before the first one whose cell is off the grid or True in ``blocked``;
     (sx, sy) when that is the first. ``frame``: the grid's :class:`pegame.grid.GridFrame`."""
@@ -78,7 +82,15 @@ def _sweep(blocked, sx, sy, tx, ty, n, frame):
     return x, y
 
 
-def _sweep_reference(grid, blocked, sx, sy, tx, ty, n):
+def _sweep_reference(
+    grid: OccupancyGrid,
+    blocked: np.ndarray,
+    sx: float,
+    sy: float,
+    tx: float,
+    ty: float,
+    n: int,
+) -> tuple[float, float]:
     """Plain-Python reference of :func:`_sweep` on ``grid``."""
     x, y = sx, sy
     for k in range(1, n + 1):
@@ -94,7 +106,7 @@ def _sweep_reference(grid, blocked, sx, sy, tx, ty, n):
 class _Agent:
     """One agent's body, its collision mask (shared, read-only) and its pose."""
 
-    def __init__(self, grid, body: Body) -> None:
+    def __init__(self, grid: OccupancyGrid, body: Body) -> None:
         self.grid = grid
         self.body = body
         self.blocked = shared_inflation(grid, body.radius)
@@ -135,7 +147,7 @@ class GridSimulator(Simulator):
     class Config:
         """No parameters: the bodies come from the pursuer and evader configs."""
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         self._pursuers = [_Agent(context.grid, context.pursuer)]
         self._evaders = [_Agent(context.grid, context.evader)]
@@ -143,7 +155,7 @@ class GridSimulator(Simulator):
     def reset(self, pursuer: Pose, evader: Pose) -> None:
         self.reset_team((pursuer,), (evader,))
 
-    def reset_team(self, pursuers, evaders) -> None:
+    def reset_team(self, pursuers: Sequence[Pose], evaders: Sequence[Pose]) -> None:
         context = self.context
         for agents, poses, body in (
             (self._pursuers, pursuers, context.pursuer),
@@ -163,7 +175,9 @@ class GridSimulator(Simulator):
         self._pursuers[0].move(pursuer_cmd, dt)
         self._evaders[0].move(evader_cmd, dt)
 
-    def step_team(self, pursuer_cmds, evader_cmds, dt: float) -> None:
+    def step_team(
+        self, pursuer_cmds: Sequence[Velocity], evader_cmds: Sequence[Velocity], dt: float
+    ) -> None:
         for agent, cmd in zip(self._pursuers, pursuer_cmds):
             agent.move(cmd, dt)
         for agent, cmd in zip(self._evaders, evader_cmds):
@@ -172,7 +186,7 @@ class GridSimulator(Simulator):
     def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
         (self._pursuers if role == "pursuer" else self._evaders)[0].move(cmd, dt)
 
-    def step_team_one(self, role: str, cmds, dt: float) -> None:
+    def step_team_one(self, role: str, cmds: Sequence[Velocity], dt: float) -> None:
         for agent, cmd in zip(self._pursuers if role == "pursuer" else self._evaders, cmds):
             agent.move(cmd, dt)
 
