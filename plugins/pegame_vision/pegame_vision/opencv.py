@@ -5,10 +5,9 @@ from __future__ import annotations
 try:
     import cv2
 except ModuleNotFoundError as exc:
-    # ``name`` is what pegame's registry tells the user to pip-install.
     raise ModuleNotFoundError(
         "No module named 'cv2': pegame-vision needs OpenCV, pip install 'opencv-python-headless>=4.8'",
-        name="opencv-python-headless",
+        name="cv2",
     ) from exc
 
 __all__ = ["cv2"]
