@@ -15,12 +15,19 @@ from __future__ import annotations
 
 import csv
 import io
+from decimal import ROUND_HALF_UP, Decimal
 from pathlib import Path
 
 from pegame.files import write_atomic
 
 HERE = Path(__file__).resolve().parent
 DOCS = HERE.parent
+
+
+def paper_percent(value: str) -> str:
+    """The paper's value (a fraction as transcribed) in % to one decimal, halves up (its
+    23.85% is 23.9, which binary floats would print as 23.8)."""
+    return str((Decimal(value) * 100).quantize(Decimal("0.1"), rounding=ROUND_HALF_UP))
 
 
 def table(path: Path) -> dict[tuple, dict]:
@@ -63,7 +70,7 @@ def main() -> int:
             r = by[(name, *key)]
             texts.append(f"{100 * r['mean']:.1f} [{100 * r['ci_low']:.1f}, {100 * r['ci_high']:.1f}] "
                          f"({100 * r['difference']:+.1f})")
-        lines.append(f"| {key[0]} | {key[1]:g} | {key[2]} | {100 * float(p['paper_mean']):.1f} | "
+        lines.append(f"| {key[0]} | {key[1]:g} | {key[2]} | {paper_percent(p['paper_mean'])} | "
                      + " | ".join(texts) + " |")
     lines += ["", "| conditions | mean absolute difference (pp) | paper values inside our CI |",
               "|---|---|---|"]
