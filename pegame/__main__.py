@@ -34,7 +34,7 @@ from omegaconf.errors import OmegaConfBaseException
 
 from pegame import sweep
 from pegame.config import register_schema
-from pegame.errors import JobDirectoryError, PegameError
+from pegame.errors import JobDirectoryError, PegameError, ResultsWriteError
 from pegame.files import make_dir, write_atomic
 from pegame.overrides import check_overrides
 
@@ -137,7 +137,9 @@ def _app(cfg: DictConfig) -> int:
     except PegameError as exc:
         if os.environ.get("HYDRA_FULL_ERROR") == "1":
             raise
-        mine = hydra_cfg.mode == RunMode.MULTIRUN and not isinstance(exc, JobDirectoryError)
+        mine = hydra_cfg.mode == RunMode.MULTIRUN and not isinstance(
+            exc, (JobDirectoryError, ResultsWriteError)
+        )  # not another job's directory, nor one that cannot be written
         if mine:  # an invalid cell of this sweep: its log and its line say why
             held.write()
         report_error(exc)

@@ -4,8 +4,9 @@ out.png`` (:mod:`pegame.movie`).
 
 Finds every recording under the run directory, recursively (a sweep keeps one directory
 per job), sorted by path: ``<game_id>.rrd`` (complete), ``<game_id>.failed.rrd`` (the
-game raised; readable up to its failure) and ``<game_id>.rrd.partial`` (the game is
-running, or its process was killed); see :mod:`pegame.recorders.files`. It opens the
+game raised; readable up to its failure) and ``<game_id>.rrd.partial`` (being written
+at its game's end, or its process was killed while writing it); see
+:mod:`pegame.recorders.files`. It opens the
 complete and failed ones together in the Rerun viewer, or with ``--list`` prints each
 path, size and status. The viewer is the ``rerun`` CLI of the rerun-sdk installed with
 this Python (``python -m rerun``), so it always reads the recordings' format version.
@@ -160,7 +161,7 @@ def main(argv: list[str] | None = None) -> int:
     readable = [path for path in files if recording_status(path) != PARTIAL]
     if len(readable) < len(files):
         print(
-            f"pegame.replay: {len(files) - len(readable)} partial recording(s) (a game running or killed) "
+            f"pegame.replay: {len(files) - len(readable)} partial recording(s) (being written, or cut) "
             "not opened; see --list.",
             file=sys.stderr,
         )

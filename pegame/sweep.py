@@ -35,7 +35,7 @@ import uuid
 from pathlib import Path
 
 from pegame.errors import JobDirectoryError
-from pegame.files import make_dir, write_failed
+from pegame.files import make_dir, write_atomic, write_failed
 
 OK, GAMES_FAILED, BAD_INPUT = 0, 1, 2
 
@@ -70,7 +70,7 @@ def job_ended(status: int) -> None:
     record(status)
     directory = os.environ.get(STATUS_DIR_ENV)
     if directory and Path(directory).is_dir():
-        (Path(directory) / f"{os.getpid()}-{uuid.uuid4().hex}").write_text(f"{status}\n")
+        write_atomic(Path(directory) / f"{os.getpid()}-{uuid.uuid4().hex}", f"{status}\n")
 
 
 def start_sweep(sweep_dir: str | Path, resume: bool = False) -> None:
@@ -150,7 +150,8 @@ def end_sweep() -> int:
     os.environ.pop(SWEEP_PID_ENV, None)
     statuses = [OK]
     if directory and Path(directory).is_dir():
-        statuses += [int(path.read_text()) for path in Path(directory).iterdir()]
+        written = [p for p in Path(directory).iterdir() if not p.name.startswith(".")]
+        statuses += [int(path.read_text()) for path in written]  # not a cut temporary file
         shutil.rmtree(directory, ignore_errors=True)
     record(max(statuses))
     return max(statuses)
