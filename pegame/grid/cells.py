@@ -19,7 +19,7 @@ from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 
 
 @njit(cache=True, inline="always")
-def point_cell(x: float, y: float, frame: tuple) -> tuple[int, int]:
+def point_cell(x: float, y: float, frame: tuple | np.ndarray) -> tuple[int, int]:
     """(row, col) of the cell containing map point (x, y) (m); may lie off the grid."""
     dx = x - frame[OX]
     dy = y - frame[OY]

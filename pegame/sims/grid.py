@@ -66,7 +66,13 @@ def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
 
 @njit(cache=True)
 def _sweep(
-    blocked: np.ndarray, sx: float, sy: float, tx: float, ty: float, n: int, frame: tuple
+    blocked: np.ndarray,
+    sx: float,
+    sy: float,
+    tx: float,
+    ty: float,
+    n: int,
+    frame: tuple | np.ndarray,
 ) -> tuple[float, float]:
     """The last of the points k/n along the chord from (sx, sy) to (tx, ty) (m, map frame),
     k = 1..n, before the first one whose cell is off the grid or True in ``blocked``;

@@ -51,6 +51,9 @@ from pegame.vector.state import (
     RADIUS,
     SEEN_X,
     SEEN_Y,
+    BatchState,
+    Rules,
+    World,
 )
 from pegame.visibility.sight import SILHOUETTE
 
@@ -61,7 +64,20 @@ _CHUNK = 32
 
 
 @njit(cache=True, inline="always")
-def _sample_cells(frame, height, width, ax, ay, bx, by, count, start, size, cells, rotated):
+def _sample_cells(
+    frame: np.ndarray,
+    height: int,
+    width: int,
+    ax: float,
+    ay: float,
+    bx: float,
+    by: float,
+    count: int,
+    start: int,
+    size: int,
+    cells: np.ndarray,
+    rotated: bool,
+) -> bool:
     """The cells (1 + flat index, 0 off the grid) of samples start..start + size - 1 of
     the segment into ``cells`` by :func:`pegame.numerics.cell_by_product`; returns
     whether all are decided. Inlined with ``rotated`` a constant (no branch in the loop).
@@ -76,7 +92,16 @@ def _sample_cells(frame, height, width, ax, ay, bx, by, count, start, size, cell
 
 
 @njit(cache=True, inline="always")
-def _sample_point(frame, ax, ay, bx, by, k, count, rotated):
+def _sample_point(
+    frame: np.ndarray,
+    ax: float,
+    ay: float,
+    bx: float,
+    by: float,
+    k: int,
+    count: int,
+    rotated: bool,
+) -> tuple[float, float]:
     """Grid-frame point (u, v) (m) of sample k of count along the segment from (ax, ay)
     to (bx, by), as :func:`pegame.visibility.sight._segment_clear` places it (the last
     one at (bx, by) itself)."""
@@ -90,7 +115,16 @@ def _sample_point(frame, ax, ay, bx, by, k, count, rotated):
 
 
 @njit(cache=True)
-def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
+def segment_clear(
+    frame: np.ndarray,
+    blocked: np.ndarray,
+    values: np.ndarray,
+    ax: float,
+    ay: float,
+    bx: float,
+    by: float,
+    step: float,
+) -> bool:
     """:func:`pegame.visibility.sight._segment_clear` on the grid: True when no sample of
     the segment from (ax, ay) to (bx, by) (m), ``step`` m apart, lies in a blocked or
     off-grid cell. The same samples and cells (the tests compare the two), found
@@ -125,7 +159,17 @@ def segment_clear(frame, blocked, values, ax, ay, bx, by, step):
 
 
 @njit(cache=True, inline="always")
-def point_in_view(frame, blocked, values, camera, px, py, ptheta, x, y):
+def point_in_view(
+    frame: np.ndarray,
+    blocked: np.ndarray,
+    values: np.ndarray,
+    camera: np.ndarray,
+    px: float,
+    py: float,
+    ptheta: float,
+    x: float,
+    y: float,
+) -> bool:
     """:func:`pegame.visibility.in_view` of the map point (x, y) (m) from the camera at
     (px, py, ptheta)."""
     dx, dy = x - px, y - py
@@ -137,7 +181,19 @@ def point_in_view(frame, blocked, values, camera, px, py, ptheta, x, y):
 
 
 @njit(cache=True, inline="always")
-def body_in_view(frame, blocked, values, camera, px, py, ptheta, x, y, radius, centre):
+def body_in_view(
+    frame: np.ndarray,
+    blocked: np.ndarray,
+    values: np.ndarray,
+    camera: np.ndarray,
+    px: float,
+    py: float,
+    ptheta: float,
+    x: float,
+    y: float,
+    radius: float,
+    centre: bool,
+) -> bool:
     """:func:`pegame.visibility.body_in_view`: any SILHOUETTE point of the body of
     ``radius`` m at (x, y) in view; ``centre``: whether its centre (the first point,
     x + 0 = x) is, already known from the detector."""
@@ -155,7 +211,17 @@ def body_in_view(frame, blocked, values, camera, px, py, ptheta, x, y, radius, c
 
 
 @njit(cache=True, inline="always")
-def detect(frame, blocked, values, camera, radius, poses, detected, detection, game):
+def detect(
+    frame: np.ndarray,
+    blocked: np.ndarray,
+    values: np.ndarray,
+    camera: np.ndarray,
+    radius: float,
+    poses: np.ndarray,
+    detected: np.ndarray,
+    detection: np.ndarray,
+    game: int,
+) -> bool:
     """The oracle detector's capture for ``game``'s current poses (state.poses) into
     ``detected`` and ``detection`` (state's; the pipeline's parts all off; ``camera``:
     rules.camera, ``radius``: the evader's). Returns whether the evader's centre is in
@@ -199,7 +265,7 @@ def detect(frame, blocked, values, camera, radius, poses, detected, detection, g
 
 
 @njit(cache=True, inline="always")
-def sense(world, rules, state, game):
+def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
     """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
     pursuer observation's memory of the last detection (``PursuerFeatures.remember``).
     The caller inlines it once per game, so that the NamedTuples' arrays are taken out

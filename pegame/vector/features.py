@@ -16,18 +16,20 @@ from pegame.envs.crop import CropLattice, CropScratch, lattice_crop
 from pegame.envs.observations import AGE_SCALE
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.numerics import cell_by_division, hypot, wrap_angle
-from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER
+from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER, BatchState, Rules, World
 
 
 @njit(cache=True, inline="always")
-def _unit(value):
+def _unit(value: float) -> float:
     """Python's ``min(1.0, max(-1.0, value))``."""
     low = value if value > -1.0 else -1.0
     return low if low < 1.0 else 1.0
 
 
 @njit(cache=True, inline="always")
-def _pose_features(extent, x, y, theta, out, at):
+def _pose_features(
+    extent: np.ndarray, x: float, y: float, theta: float, out: np.ndarray, at: int
+) -> None:
     """``_Features._pose``: normalised position, cos and sin of the heading."""
     x0, y0, sx, sy = extent[0], extent[1], extent[2], extent[3]
     out[at] = _unit((x - x0) * sx - 1.0)
@@ -37,7 +39,9 @@ def _pose_features(extent, x, y, theta, out, at):
 
 
 @njit(cache=True)
-def _divided_crop(world, x, y, c, s, out, at):
+def _divided_crop(
+    world: World, x: float, y: float, c: float, s: float, out: np.ndarray, at: int
+) -> None:
     """The crop's cells by the reference's own operations (:func:`pegame.envs.crop._crop`,
     ``world_to_cell``'s division), into out[at:]."""
     table, off_x, off_y, frame = world.crop_table, world.crop_x, world.crop_y, world.crop_frame
@@ -58,7 +62,9 @@ def _divided_crop(world, x, y, c, s, out, at):
 
 
 @njit(cache=True)
-def crop_into(world, x, y, theta, out, at, cells):
+def crop_into(
+    world: World, x: float, y: float, theta: float, out: np.ndarray, at: int, cells: np.ndarray
+) -> bool:
     """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
     rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int32
     scratch of the crop's size): from the crop's lattice (:func:`pegame.envs.crop.lattice_crop`), or by
@@ -77,7 +83,18 @@ def crop_into(world, x, y, theta, out, at, cells):
 
 
 @njit(cache=True, inline="always")
-def _pursuer_row(extent, poses, detected, has_seen, seen, steps, far, dt, game, row):
+def _pursuer_row(
+    extent: np.ndarray,
+    poses: np.ndarray,
+    detected: np.ndarray,
+    has_seen: np.ndarray,
+    seen: np.ndarray,
+    steps: np.ndarray,
+    far: float,
+    dt: float,
+    game: int,
+    row: np.ndarray,
+) -> None:
     """``PursuerFeatures.build`` (no belief part, no crop) of ``game`` into ``row``, from
     the state's arrays (a NamedTuple passed to an inlined function costs a reference
     count per array)."""
@@ -94,7 +111,7 @@ def _pursuer_row(extent, poses, detected, has_seen, seen, steps, far, dt, game, 
 
 
 @njit(cache=True, inline="always")
-def _evader_row(extent, poses, game, row):
+def _evader_row(extent: np.ndarray, poses: np.ndarray, game: int, row: np.ndarray) -> None:
     """``EvaderFeatures.build`` (no crop) of ``game`` into ``row``."""
     diagonal = extent[4]
     ex, ey, etheta = poses[game, EVADER, 0], poses[game, EVADER, 1], poses[game, EVADER, 2]
@@ -115,7 +132,9 @@ _BLOCK = 64
 
 
 @njit(cache=True)
-def _features_block(world, rules, state, out, pursuer, block):
+def _features_block(
+    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool, block: int
+) -> None:
     """The rows of the games of ``block``: the arrays are taken out of the NamedTuples
     once per block, not per game."""
     scratch = CropScratch(
@@ -142,18 +161,22 @@ def _features_block(world, rules, state, out, pursuer, block):
 
 
 @njit(cache=True)
-def _features_serial(world, rules, state, out, pursuer):
+def _features_serial(
+    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool
+) -> None:
     for block in range(-(-out.shape[0] // _BLOCK)):
         _features_block(world, rules, state, out, pursuer, block)
 
 
 @njit(cache=True, parallel=True)
-def _features_parallel(world, rules, state, out, pursuer):
+def _features_parallel(
+    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool
+) -> None:
     for block in prange(-(-out.shape[0] // _BLOCK)):
         _features_block(world, rules, state, out, pursuer, block)
 
 
-def features(world, rules, state, out, role):
+def features(world: World, rules: Rules, state: BatchState, out: np.ndarray, role: int) -> None:
     """The observation of ``role`` (PURSUER or EVADER) in every game into out (N, size)."""
     kernel = _features_parallel if out.shape[0] >= PARALLEL_GAMES else _features_serial
     kernel(world, rules, state, out, role == PURSUER)

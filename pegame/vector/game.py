@@ -48,10 +48,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import NoReturn
 
 import numpy as np
 from omegaconf import DictConfig
 
+from pegame.api import Context
 from pegame.detectors.oracle import OracleDetector
 from pegame.detectors.perception import detection_range
 from pegame.envs.crop import LocalCrop
@@ -59,6 +61,7 @@ from pegame.envs.observations import EvaderFeatures, PursuerFeatures
 from pegame.envs.settings import EnvSettings
 from pegame.errors import ConfigError
 from pegame.game import STREAMS, Scenario, spawn
+from pegame.grid import OccupancyGrid
 from pegame.navigation import shared_inflation
 from pegame.sims.grid import GridSimulator
 from pegame.vector import kernels
@@ -94,7 +97,7 @@ PERCEPTION_OFF = {
 def check_playable(scenario: Scenario, settings: EnvSettings) -> None:
     """ConfigError naming the first key whose value the batched game does not play."""
 
-    def refuse(key: str, value, allowed: str) -> None:
+    def refuse(key: str, value: object, allowed: str) -> NoReturn:
         raise ConfigError(
             f"Invalid value for '{key}' in a batched env: {value!r}. Allowed: {allowed} "
             "(the batched kernels play only these; use the single env for the rest)."
@@ -240,7 +243,7 @@ class BatchedGame:
 _NO_TABLE = np.zeros((1, 1, 2))
 
 
-def _world(grid, context, settings: EnvSettings) -> World:
+def _world(grid: OccupancyGrid, context: Context, settings: EnvSettings) -> World:
     crop = LocalCrop(grid, settings.crop_cells, settings.crop_resolution)
     x0, x1, y0, y1 = grid.extent
     masks = np.stack(

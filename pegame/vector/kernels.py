@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from pegame.grid.occupancy import RESOLUTION
@@ -51,18 +52,21 @@ from pegame.vector.state import (
     TICKS,
     V_MAX,
     W_MAX,
+    BatchState,
+    Rules,
+    World,
 )
 
 
 @njit(cache=True, inline="always")
-def _clamp(value, limit):
+def _clamp(value: float, limit: float) -> float:
     """:func:`pegame.types.clamp`: min(max(value, -limit), limit) with Python's min/max."""
     low = value if value > -limit else -limit
     return low if low < limit else limit
 
 
 @njit(cache=True, inline="always")
-def _ramp(current, target, limit):
+def _ramp(current: float, target: float, limit: float) -> float:
     """:func:`pegame.sims.grid._ramp`."""
     if math.isinf(limit):
         return target
@@ -70,7 +74,17 @@ def _ramp(current, target, limit):
 
 
 @njit(cache=True, inline="always")
-def move(masks, frame, bodies, poses, velocities, commands, game, role, dt):
+def move(
+    masks: np.ndarray,
+    frame: np.ndarray,
+    bodies: np.ndarray,
+    poses: np.ndarray,
+    velocities: np.ndarray,
+    commands: np.ndarray,
+    game: int,
+    role: int,
+    dt: float,
+) -> None:
     """Move ``role`` of ``game`` by its command for ``dt`` s (the grid simulator's move),
     from the world's masks and frame, rules.bodies and the state's poses, velocities and
     commands. Elements are read by index, not through row views, and the arrays are
@@ -99,7 +113,14 @@ def move(masks, frame, bodies, poses, velocities, commands, game, role, dt):
 
 
 @njit(cache=True, inline="always")
-def tally(t, poses, in_view, detected, game, dt):
+def tally(
+    t: np.ndarray,
+    poses: np.ndarray,
+    in_view: np.ndarray,
+    detected: np.ndarray,
+    game: int,
+    dt: float,
+) -> None:
     """``TrackingMetrics.add`` for ``game``'s current tick, as running sums (no belief),
     into ``t`` = state.tally from the state's poses, in_view and detected."""
     g = game
@@ -132,7 +153,16 @@ def tally(t, poses, in_view, detected, game, dt):
 
 
 @njit(cache=True)
-def _play_game(world, rules, state, game, playing, ticks, table, table_role):
+def _play_game(
+    world: World,
+    rules: Rules,
+    state: BatchState,
+    game: int,
+    playing: np.ndarray,
+    ticks: int,
+    table: np.ndarray,
+    table_role: int,
+) -> None:
     """Up to ``ticks`` control ticks of ``game`` in the loop's order (see
     :mod:`pegame.vector.game`): the scripted command, the measures, the simulator's
     substeps, the next tick sensed. The arrays are taken out of the NamedTuples once."""
@@ -158,18 +188,42 @@ def _play_game(world, rules, state, game, playing, ticks, table, table_role):
 
 
 @njit(cache=True)
-def _play_serial(world, rules, state, playing, ticks, table, table_role):
+def _play_serial(
+    world: World,
+    rules: Rules,
+    state: BatchState,
+    playing: np.ndarray,
+    ticks: int,
+    table: np.ndarray,
+    table_role: int,
+) -> None:
     for game in range(playing.size):
         _play_game(world, rules, state, game, playing, ticks, table, table_role)
 
 
 @njit(cache=True, parallel=True)
-def _play_parallel(world, rules, state, playing, ticks, table, table_role):
+def _play_parallel(
+    world: World,
+    rules: Rules,
+    state: BatchState,
+    playing: np.ndarray,
+    ticks: int,
+    table: np.ndarray,
+    table_role: int,
+) -> None:
     for game in prange(playing.size):
         _play_game(world, rules, state, game, playing, ticks, table, table_role)
 
 
-def play(world, rules, state, playing, ticks, table, table_role):
+def play(
+    world: World,
+    rules: Rules,
+    state: BatchState,
+    playing: np.ndarray,
+    ticks: int,
+    table: np.ndarray,
+    table_role: int,
+) -> None:
     """Play up to ``ticks`` control ticks of every game where ``playing`` (bool (N,)) is
     set, each stopping at its last tick; state.rewards counts the detections. ``table``
     (N, decisions, 2): the (v, w) commands of a scripted role ``table_role`` (-1: none) per
@@ -179,23 +233,23 @@ def play(world, rules, state, playing, ticks, table, table_role):
 
 
 @njit(cache=True)
-def _sense_game(world, rules, state, game):
+def _sense_game(world: World, rules: Rules, state: BatchState, game: int) -> None:
     sense(world, rules, state, game)
 
 
 @njit(cache=True)
-def _sense_serial(world, rules, state, games):
+def _sense_serial(world: World, rules: Rules, state: BatchState, games: np.ndarray) -> None:
     for k in range(games.size):
         _sense_game(world, rules, state, games[k])
 
 
 @njit(cache=True, parallel=True)
-def _sense_parallel(world, rules, state, games):
+def _sense_parallel(world: World, rules: Rules, state: BatchState, games: np.ndarray) -> None:
     for k in prange(games.size):
         _sense_game(world, rules, state, games[k])
 
 
-def sense_games(world, rules, state, games):
+def sense_games(world: World, rules: Rules, state: BatchState, games: np.ndarray) -> None:
     """:func:`sense` for the games listed in ``games`` (int (K,)), e.g. just reset."""
     kernel = _sense_parallel if games.size >= PARALLEL_GAMES else _sense_serial
     kernel(world, rules, state, games)

@@ -20,10 +20,20 @@ have no estimation error, n_eff or resamplings (None and 0).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from pegame.api import EvaderObservation, PursuerObservation
+from pegame.api import (
+    Context,
+    Estimator,
+    Evader,
+    EvaderObservation,
+    Pursuer,
+    PursuerObservation,
+)
 from pegame.evaders.random import RandomEvader
+from pegame.game import Scenario
 from pegame.metrics import TrackingMetrics
 from pegame.pursuers.random import RandomPursuer
 from pegame.types import BoundingBox, Detection, Pose
@@ -39,6 +49,7 @@ from pegame.vector.state import (
     SEEN_Y,
     V_MAX,
     W_MAX,
+    BatchState,
 )
 from pegame.visibility import VisibilityRegion
 
@@ -64,10 +75,12 @@ class ActionTable:
         self.table[game, :, 0] = 0.0 + (self.v_max - 0.0) * u[:, 0]
         self.table[game, :, 1] = -self.w_max + (self.w_max - -self.w_max) * u[:, 1]
 
-    def command(self, state, games: np.ndarray, time: np.ndarray, deciding: np.ndarray) -> None:
+    def command(
+        self, state: BatchState, games: np.ndarray, time: np.ndarray, deciding: np.ndarray
+    ) -> None:
         """Nothing: the tick kernel reads the table."""
 
-    def sensed(self, state, games: np.ndarray, dt: float) -> None:
+    def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
         """Nothing: the table does not look."""
 
 
@@ -77,7 +90,7 @@ class StrategyOpponent:
     role = EVADER
     table = None
 
-    def __init__(self, cls, config, context, num_games: int) -> None:
+    def __init__(self, cls: type[Evader], config: Any, context: Context, num_games: int) -> None:
         self.cls, self.config, self.context = cls, config, context
         self.strategies: list = [None] * num_games
 
@@ -88,10 +101,12 @@ class StrategyOpponent:
         strategy.reset(pose)
         self.strategies[game] = strategy
 
-    def sensed(self, state, games: np.ndarray, dt: float) -> None:
+    def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
         """Nothing: the evader is told the poses when it is asked."""
 
-    def command(self, state, games: np.ndarray, time: np.ndarray, deciding: np.ndarray) -> None:
+    def command(
+        self, state: BatchState, games: np.ndarray, time: np.ndarray, deciding: np.ndarray
+    ) -> None:
         """Write the strategies' commands for ``games`` into state.commands: each is given
         its observation at ``time[k]`` s and decides first where ``deciding[k]`` (the
         loop's order)."""
@@ -113,7 +128,14 @@ class PursuerStrategyOpponent:
     role = PURSUER
     table = None
 
-    def __init__(self, cls, config, estimator, context, num_games: int) -> None:
+    def __init__(
+        self,
+        cls: type[Pursuer],
+        config: Any,
+        estimator: tuple[type[Estimator], Any],
+        context: Context,
+        num_games: int,
+    ) -> None:
         self.cls, self.config, self.context = cls, config, context
         self.estimator_cls, self.estimator_config = estimator
         self.strategies: list = [None] * num_games
@@ -132,7 +154,7 @@ class PursuerStrategyOpponent:
         )
         self.metrics[game] = TrackingMetrics(context.control_dt)
 
-    def sensed(self, state, games: np.ndarray, dt: float) -> None:
+    def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
         """The loop's estimation after a tick is sensed (``_sense``): each game's region
         at the pursuer's pose and its estimator's belief from the detection (a reset at
         tick 0)."""
@@ -155,7 +177,9 @@ class PursuerStrategyOpponent:
                 belief = estimator.update(dt, pose, detection, region)
             self.seen[game] = (detection, region, belief)
 
-    def command(self, state, games: np.ndarray, time: np.ndarray, deciding: np.ndarray) -> None:
+    def command(
+        self, state: BatchState, games: np.ndarray, time: np.ndarray, deciding: np.ndarray
+    ) -> None:
         """The strategies' commands for ``games`` at ``time[k]`` s (deciding first where
         ``deciding[k]``) into state.commands, and the tick's measures (``metrics.add``)."""
         poses, commands = state.poses, state.commands
@@ -175,7 +199,9 @@ class PursuerStrategyOpponent:
             self.metrics[game].add(pursuer, evader, detected, in_view, belief)
 
 
-def opponent_for(scenario, learner: str, bodies: np.ndarray, num_games: int):
+def opponent_for(
+    scenario: Scenario, learner: str, bodies: np.ndarray, num_games: int
+) -> ActionTable | StrategyOpponent | PursuerStrategyOpponent:
     """The opponent of ``learner`` ('pursuer' or 'evader') in ``scenario``'s games."""
     role = "evader" if learner == "pursuer" else "pursuer"
     cls, config = scenario.classes[role], scenario.configs[role]
@@ -185,6 +211,9 @@ def opponent_for(scenario, learner: str, bodies: np.ndarray, num_games: int):
     if cls in (RandomEvader, RandomPursuer) and config.model == "action":
         return ActionTable(index, bodies[index], num_games, decisions)
     if role == "evader":
+        assert issubclass(cls, Evader)  # the scenario's classes implement their kinds
         return StrategyOpponent(cls, config, scenario.context, num_games)
-    estimator = (scenario.classes["estimator"], scenario.configs["estimator"])
-    return PursuerStrategyOpponent(cls, config, estimator, scenario.context, num_games)
+    estimator = scenario.classes["estimator"]
+    assert issubclass(cls, Pursuer) and issubclass(estimator, Estimator)
+    pair = (estimator, scenario.configs["estimator"])
+    return PursuerStrategyOpponent(cls, config, pair, scenario.context, num_games)
