@@ -237,7 +237,7 @@ class PolicyPlayer:
         return self.command
 
 
-class PolicyStrategy(Strategy):
+class PolicyStrategy(Strategy[PursuerObservation | EvaderObservation]):
     """A trained policy (linear .npz or a callable) on its role's env observation; it
     commands velocities directly and makes no plan."""
 

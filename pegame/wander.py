@@ -124,7 +124,7 @@ class RandomOptions:
         require(self.model in MODELS, "model", " or ".join(MODELS), self.model)
 
 
-class RandomStrategy(Strategy):
+class RandomStrategy(Strategy[PursuerObservation | EvaderObservation]):
     """The paper's random agent for either role (paper, Sec. "Random Pursuer and Evader"),
     ``model`` as the module docstring describes; it ignores what it sees. The ``random``
     pursuer and evader are this behaviour (:func:`pegame.roles.for_role`)."""
