@@ -14,6 +14,7 @@ imported, when Hydra loads its file.
 
 from __future__ import annotations
 
+import functools
 import sys
 from dataclasses import fields
 from importlib.metadata import entry_points
@@ -66,10 +67,29 @@ def option_file(kind: str, name: str) -> Traversable | None:
 def plugin_defaults(kind: str, name: str) -> dict[str, Any]:
     """The defaults of every field of the ``Config`` of plugin ``name`` of group ``kind``
     (imports the plugin; a field without a default is ``'???'``, Hydra's missing value)."""
-    config = registry.load(kind, name).Config
+    return dict(_defaults_of(registry.load(kind, name).Config))
+
+
+@functools.cache
+def _defaults_of(config: type) -> dict[str, Any]:
+    """:func:`plugin_defaults` of the dataclass ``config``, read once per class (0.8 ms)."""
     values = OmegaConf.to_container(OmegaConf.structured(config))
     assert isinstance(values, dict)
     return {f.name: values[f.name] for f in fields(config)}
+
+
+def merged(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    """``over`` merged into ``base`` as OmegaConf.merge merges mappings (a mapping into a
+    mapping key by key, any other value replacing), for plain containers."""
+    return {
+        **base,
+        **{
+            key: merged(base[key], value)
+            if isinstance(value, dict) and isinstance(base.get(key), dict)
+            else value
+            for key, value in over.items()
+        },
+    }
 
 
 def option_kind(config_path: str) -> str | None:
@@ -93,7 +113,12 @@ class PluginOptionSource(ImportlibResourcesConfigSource):
         written = result.config
         if kind is not None and isinstance(written, DictConfig) and "name" in written:
             name = str(written.name)
-            result.config = OmegaConf.merge({"name": name}, plugin_defaults(kind, name), written)
+            own = OmegaConf.to_container(written)  # interpolations kept as written
+            assert isinstance(own, dict)
+            # Plain containers: OmegaConf.merge of the nodes takes three times as long.
+            result.config = OmegaConf.create(
+                merged({"name": name, **plugin_defaults(kind, name)}, own)
+            )
         return result
 
 

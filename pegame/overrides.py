@@ -8,11 +8,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import fields
-from importlib.metadata import entry_points
 from importlib.resources import files
 
 from pegame.api import PLUGIN_KINDS
 from pegame.config import EnvConfig, GameConfig, Schema, TeamConfig, did_you_mean
+from pegame.defaults import config_packages
 from pegame.errors import ConfigError, PluginChoiceError
 from pegame.types import Camera
 
@@ -31,9 +31,8 @@ FIXED_NODES: dict[str, type] = {
 def plugin_options(kind: str) -> list[str]:
     """The config options of group ``kind`` that Hydra finds on pegame's search path:
     pegame's own ``conf/<kind>/*.yaml`` and those of plugin distributions."""
-    packages = ["pegame.conf", *(point.value for point in entry_points(group="pegame.configs"))]
     options = set()
-    for package in packages:
+    for package in config_packages().values():
         try:
             folder = files(package) / kind
         except ModuleNotFoundError:

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 from omegaconf import OmegaConf
 
-from pegame import defaults, registry
+from pegame import defaults, overrides, registry
 from pegame.api import INTERFACES
 from pegame.config import GameConfig, TeamConfig, compose
 from pegame.errors import ConfigError
@@ -79,7 +79,8 @@ def installed(monkeypatch):
             monkeypatch.syspath_prepend(str(dist))
             (package,) = project_of(dist)["entry-points"]["pegame.configs"].values()
             packages = {**defaults.config_packages(), "pegame-plugin-spinner": package}
-            monkeypatch.setattr(defaults, "config_packages", lambda: packages)
+            for module in (defaults, overrides):  # the search path, the choices' check
+                monkeypatch.setattr(module, "config_packages", lambda: packages)
             point = registry.EntryPoint(name, target, GROUPS[group])
             known = registry._entry_points
 
@@ -221,3 +222,10 @@ def test_config_yaml_holds_no_values_and_the_nodes_are_the_dataclass_defaults(no
     composed = compose([])[node]
     made = schema()
     assert {f.name: composed[f.name] for f in dataclasses.fields(made)} == dataclasses.asdict(made)
+
+
+def test_option_files_merge_over_the_defaults_as_omegaconf_merges():
+    base = {"name": "x", "nested": {"a": 1, "b": {"c": 2, "d": 3}}, "listed": [1, 2], "n": 3}
+    over = {"nested": {"b": {"c": 5}}, "listed": [9], "interpolated": "${..n}"}
+    expected = OmegaConf.to_container(OmegaConf.merge(base, over))
+    assert defaults.merged(base, over) == expected
