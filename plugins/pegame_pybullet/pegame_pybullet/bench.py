@@ -23,8 +23,10 @@ import numpy as np
 from pegame import registry
 from pegame.config import compose
 from pegame.game import Game, spawn
-from pegame.types import Pose, Velocity, wrap_angle
+from pegame.grid import OccupancyGrid
+from pegame.types import Camera, Pose, Velocity, wrap_angle
 from pegame.visibility import line_of_sight
+from pegame_pybullet.sim import PybulletSimulator
 
 ARC = Velocity(0.3, 0.5)  # m/s, rad/s: a command that keeps the agents moving
 
@@ -66,7 +68,7 @@ def rtf(
     return {"rtf": sim_time / wall, "rtf_cpu": sim_time / cpu}
 
 
-def _why(grid, camera, radius: float, pursuer: Pose, evader: Pose) -> str:
+def _why(grid: OccupancyGrid, camera: Camera, radius: float, pursuer: Pose, evader: Pose) -> str:
     """Why pixels of the evader show while its body, as the grid models it, is not in view
     (see :func:`visibility_agreement`)."""
     dx, dy = evader.x - pursuer.x, evader.y - pursuer.y
@@ -127,7 +129,8 @@ def visibility_agreement(
             ]
             played = Game(compose(["sim=grid", "detector=oracle", *base])).play(out)
             game = Game(compose(["sim=pybullet", "detector=segmentation", *base]))
-            sim, detector, context = game.plugins.sim, game.plugins.detector, game.context
+            sim = PybulletSimulator.narrow(game.plugins.sim)
+            detector, context = game.plugins.detector, game.context
             try:
                 for row in played.trajectory:
                     p, e = Pose(*row[2:5]), Pose(*row[5:8])

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
+from typing import Any
 
 import pybullet
 
@@ -20,7 +22,7 @@ class Client:
         if self.id < 0:
             raise RuntimeError("pybullet could not connect a physics server (GUI needs a display)")
 
-    def __getattr__(self, name: str):
+    def __getattr__(self, name: str) -> Callable[..., Any]:
         if self.id < 0:
             raise RuntimeError("the pybullet client is disconnected")
         return functools.partial(getattr(pybullet, name), physicsClientId=self.id)

@@ -26,30 +26,56 @@ Needs a simulator that renders segmentation (``sim=pybullet``); imports no pybul
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
-from pegame.api import Detector
+from pegame.api import Context, Detector
 from pegame.detectors.perception import Perception, PerceptionConfig
 from pegame.errors import ConfigError, require
-from pegame.types import BoundingBox, Detection, SensorFrame
+from pegame.types import BoundingBox, Camera, Detection, SensorFrame
 
 
-def backproject(frame: SensorFrame, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+class Rendered(NamedTuple):
+    """What the detector reads of a rendered frame: the segmentation mask and the depth
+    image (m) (H, W), the intrinsics K (3, 3), the camera-to-map transform (4, 4) and the
+    evader's label in the mask."""
+
+    segmentation: np.ndarray
+    depth: np.ndarray
+    intrinsics: np.ndarray
+    camera_to_map: np.ndarray
+    evader: int
+
+
+def rendered(frame: SensorFrame) -> Rendered:
+    """The images of ``frame``; ConfigError when the simulator does not render them."""
+    seg, depth, k, to_map = frame.segmentation, frame.depth, frame.intrinsics, frame.camera_to_map
+    labels = frame.labels or {}
+    if seg is None or depth is None or k is None or to_map is None or "evader" not in labels:
+        raise ConfigError(
+            "detector=segmentation needs a simulator that renders a segmentation mask with an "
+            "'evader' label (sim=pybullet); use detector=oracle with sim=grid."
+        )
+    return Rendered(seg, depth, k, to_map, labels["evader"])
+
+
+def backproject(images: Rendered, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """(3, N) map-frame points (m) of the pixels (rows, cols) at their depth."""
-    k = frame.intrinsics
-    z = frame.depth[rows, cols]
+    k = images.intrinsics
+    z = images.depth[rows, cols]
     optical = np.stack(
         [(cols + 0.5 - k[0, 2]) * (z / k[0, 0]), (rows + 0.5 - k[1, 2]) * (z / k[1, 1]), z]
     )
-    return frame.camera_to_map[:3, :3] @ optical + frame.camera_to_map[:3, 3:]
+    return images.camera_to_map[:3, :3] @ optical + images.camera_to_map[:3, 3:]
 
 
-def box_in_camera_frame(frame: SensorFrame, camera, left, top, right, bottom) -> BoundingBox:
+def box_in_camera_frame(
+    images: Rendered, camera: Camera, left: float, top: float, right: float, bottom: float
+) -> BoundingBox:
     """A box given by pixel edges (px of the rendered image) in the pursuer camera's
     ``image_width`` x ``image_height`` frame."""
-    height, width = frame.depth.shape
+    height, width = images.depth.shape
     sx, sy = camera.image_width / width, camera.image_height / height
     return BoundingBox(
         float(left * sx), float(top * sy), float((right - left) * sx), float((bottom - top) * sy)
@@ -80,7 +106,7 @@ class SegmentationDetector(Detector):
                 self.surface_offset,
             )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         self.perception = Perception(config, context, rng)
 
@@ -98,17 +124,13 @@ class SegmentationDetector(Detector):
 
     def _see(self, frame: SensorFrame) -> Detection | None:
         """The evader's detection in this frame's segmentation, before the perception model."""
-        if frame.segmentation is None or frame.labels is None or "evader" not in frame.labels:
-            raise ConfigError(
-                "detector=segmentation needs a simulator that renders a segmentation mask with an "
-                "'evader' label (sim=pybullet); use detector=oracle with sim=grid."
-            )
+        images = rendered(frame)
         camera = self.context.camera
-        rows, cols = np.nonzero(frame.segmentation == frame.labels["evader"])
+        rows, cols = np.nonzero(images.segmentation == images.evader)
         if rows.size < self.config.min_pixels:
             return None
-        x, y, _ = backproject(frame, rows, cols)
-        origin = frame.camera_to_map[:2, 3]
+        x, y, _ = backproject(images, rows, cols)
+        origin = images.camera_to_map[:2, 3]
         ranges = np.hypot(x - origin[0], y - origin[1])
         keep = (ranges >= camera.near) & (ranges <= camera.far)
         kept = int(np.count_nonzero(keep))
@@ -117,10 +139,10 @@ class SegmentationDetector(Detector):
         if kept < rows.size:
             rows, cols, x, y = rows[keep], cols[keep], x[keep], y[keep]
         box = box_in_camera_frame(
-            frame, camera, cols.min(), rows.min(), cols.max() + 1, rows.max() + 1
+            images, camera, cols.min(), rows.min(), cols.max() + 1, rows.max() + 1
         )
         surface = np.array([np.median(x), np.median(y)])
         ray = surface - origin
         position = surface + self.config.surface_offset * ray / max(float(np.hypot(*ray)), 1e-9)
-        depth = float(np.median(frame.depth[rows, cols]))
+        depth = float(np.median(images.depth[rows, cols]))
         return Detection(box=box, depth=depth, position=(float(position[0]), float(position[1])))

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet
 
-from pegame.api import Simulator
+from pegame.api import Context, Simulator
 from pegame.errors import ConfigError, require
 from pegame.sims.grid import saturate, unicycle
 from pegame.types import Body, Pose, SensorFrame, Velocity
@@ -165,7 +165,7 @@ class PybulletSimulator(Simulator):
             require(abs(tilt) < 0.5 * math.pi, "camera_tilt", "(-pi/2, pi/2) rad", tilt)
             require(inset >= 0, "collision_inset", "a number of cells >= 0", inset)
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         inset = config.collision_inset * context.grid.resolution
         for role, body in (("pursuer", context.pursuer), ("evader", context.evader)):
@@ -186,6 +186,13 @@ class PybulletSimulator(Simulator):
         self._frame: SensorFrame | None = None
 
     # ------------------------------------------------------------------ world
+
+    @property
+    def client(self) -> Client:
+        """The connection to the physics server (made by the first reset or place)."""
+        if self._client is None:
+            raise RuntimeError("The pybullet simulator is not connected: reset it first.")
+        return self._client
 
     def _connect(self) -> None:
         ctx, cfg = self.context, self.config
@@ -216,8 +223,8 @@ class PybulletSimulator(Simulator):
     def _frame_gui(self) -> None:
         """Point the GUI's camera down at the middle of the map."""
         x0, x1, y0, y1 = self.context.grid.extent
-        self._client.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0)
-        self._client.resetDebugVisualizerCamera(
+        self.client.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0)
+        self.client.resetDebugVisualizerCamera(
             max(x1 - x0, y1 - y0), 0.0, -89.0, [0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.0]
         )
 
@@ -274,16 +281,16 @@ class PybulletSimulator(Simulator):
         and the camera composites the floor in closed form, faster than rasterising it (in
         the GUI the floor body stays put, for the viewer, and gives the same image)."""
         floor = self.world.floor
-        placed = self._client.getBasePositionAndOrientation(floor)
+        placed = self.client.getBasePositionAndOrientation(floor)
         self._pursuer.hide()
         if not self.config.gui:
-            self._client.resetBasePositionAndOrientation(floor, [0.0, 0.0, HIDDEN_Z], placed[1])
+            self.client.resetBasePositionAndOrientation(floor, [0.0, 0.0, HIDDEN_Z], placed[1])
         try:
             return self.camera.render(transform, floor)
         finally:
             self._pursuer.show()
             if not self.config.gui:
-                self._client.resetBasePositionAndOrientation(floor, *placed)
+                self.client.resetBasePositionAndOrientation(floor, *placed)
 
     def close(self) -> None:
         if self._client is not None:
@@ -308,7 +315,7 @@ class PybulletSimulator(Simulator):
             return 0.0
         camera = self.context.camera
         wide = DepthCamera(
-            self._client,
+            self.client,
             scale * self.config.width,
             scale * self.config.height,
             2.0 * math.atan(scale * math.tan(0.5 * camera.fov)),
@@ -318,15 +325,17 @@ class PybulletSimulator(Simulator):
             self.config.camera_tilt,
         )
         others = [*self.world.walls, self.world.floor, self.labels["pursuer"]]
-        placed = [self._client.getBasePositionAndOrientation(body) for body in others]
+        placed = [self.client.getBasePositionAndOrientation(body) for body in others]
         for body, (position, orientation) in zip(others, placed):
-            self._client.resetBasePositionAndOrientation(
+            self.client.resetBasePositionAndOrientation(
                 body, [*position[:2], HIDDEN_Z], orientation
             )
         try:
-            _, _, alone = wide.render(frame.camera_to_map, self.world.floor)
+            transform = frame.camera_to_map
+            assert transform is not None  # this simulator's frames carry it
+            _, _, alone = wide.render(transform, self.world.floor)
         finally:
             for body, (position, orientation) in zip(others, placed):
-                self._client.resetBasePositionAndOrientation(body, position, orientation)
+                self.client.resetBasePositionAndOrientation(body, position, orientation)
         whole = int(np.count_nonzero(alone == evader))
         return min(1.0, seen / whole) if whole else 0.0

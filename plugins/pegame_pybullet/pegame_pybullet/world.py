@@ -35,7 +35,7 @@ def merge_rectangles(mask: np.ndarray) -> list[tuple[int, int, int, int]]:
     todo = np.array(mask, dtype=bool)
     height, width = todo.shape
     flat = todo.ravel()  # a view: covering cells in ``todo`` updates it
-    rects = []
+    rects: list[tuple[int, int, int, int]] = []
     start = 0
     while True:
         # Every cell before ``start`` is covered, so the scans add up to one pass; argmax

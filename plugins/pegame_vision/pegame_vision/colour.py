@@ -20,7 +20,8 @@ def parse_hex(colour: str) -> tuple[float, float, float]:
     text = colour.strip().lstrip("#")
     if len(text) != 6:
         raise ValueError(colour)
-    return tuple(int(text[i : i + 2], 16) / 255 for i in (0, 2, 4))
+    red, green, blue = (int(text[i : i + 2], 16) / 255 for i in (0, 2, 4))
+    return red, green, blue
 
 
 class ColourModel:

@@ -31,11 +31,11 @@ already shows what is hidden.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
-from pegame.api import Detector
+from pegame.api import Context, Detector
 from pegame.detectors.perception import Perception, PerceptionConfig
 from pegame.errors import ConfigError, require
 from pegame.types import BoundingBox, Detection, SensorFrame
@@ -46,6 +46,21 @@ from pegame_vision.tracker import BoxTracker
 #: the clothing and skin of sim=pybullet's evader: shirt, trousers, skin
 EVADER_COLOURS = ["#cc1f1a", "#1f38a6", "#dead8c"]
 MIN_SAMPLES = 3  # back-projected samples needed to place the evader
+
+#: a box (left, top, right, bottom) in pixels of the rendered image
+Box = tuple[float, float, float, float]
+#: a box and the (rows, cols) of the evader's sample pixels in it
+Samples = tuple[Box, np.ndarray, np.ndarray]
+
+
+class RGBD(NamedTuple):
+    """What the detector reads of a frame: the RGB (H, W, 3) and depth (H, W, m) images,
+    the intrinsics K (3, 3) and the camera-to-map transform (4, 4)."""
+
+    rgb: np.ndarray
+    depth: np.ndarray
+    intrinsics: np.ndarray
+    camera_to_map: np.ndarray
 
 
 class VisionDetector(Detector):
@@ -113,7 +128,7 @@ class VisionDetector(Detector):
                 self.surface_offset,
             )
 
-    def __init__(self, config, context, rng) -> None:
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
         self.model = ColourModel(
             config.colours, config.hue_tolerance, config.min_saturation, config.min_value
@@ -145,26 +160,29 @@ class VisionDetector(Detector):
 
     def _see(self, frame: SensorFrame) -> Detection | None:
         """This frame's detection by colour or tracking, before the perception model."""
-        needed = (frame.rgb, frame.depth, frame.intrinsics, frame.camera_to_map)
-        if any(value is None for value in needed):
+        rgb, depth, k, to_map = frame.rgb, frame.depth, frame.intrinsics, frame.camera_to_map
+        if rgb is None or depth is None or k is None or to_map is None:
             raise ConfigError(
                 "detector=vision needs RGB-D frames with the camera calibration (sim=pybullet); "
                 "use detector=oracle with sim=grid."
             )
-        gray = cv2.cvtColor(frame.rgb, cv2.COLOR_RGB2GRAY)
-        samples, source = (self._track(frame, gray) if self._tracking else None), "track"
+        images = RGBD(rgb, depth, k, to_map)
+        gray = cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY)
+        samples, source = (self._track(images, gray) if self._tracking else None), "track"
         if samples is None:
-            samples, source = self._detect(frame, gray), "detect"
-        self._last = None if samples is None else self._place(frame, *samples)
+            samples, source = self._detect(images, gray), "detect"
+        self._last = None if samples is None else self._place(images, *samples)
         self.source = None if self._last is None else source
         return self._last
 
-    def _track(self, frame: SensorFrame, gray: np.ndarray):
+    def _track(self, images: RGBD, gray: np.ndarray) -> Samples | None:
         """(box, rows, cols) from Lucas-Kanade, or None when it is time or necessary to
         detect again."""
         if self._since_detection >= self.config.redetect_every:
             return None
-        survivors = self.tracker.step(gray, lambda points: self.model.matches_at(frame.rgb, points))
+        survivors = self.tracker.step(
+            gray, lambda points: self.model.matches_at(images.rgb, points)
+        )
         if survivors < self.config.min_features:
             self._tracking = False
             return None
@@ -175,9 +193,9 @@ class VisionDetector(Detector):
         points = self.tracker.points
         return box, points[:, 1].astype(int), points[:, 0].astype(int)
 
-    def _detect(self, frame: SensorFrame, gray: np.ndarray):
+    def _detect(self, images: RGBD, gray: np.ndarray) -> Samples | None:
         """(box, rows, cols) of the pixels matching the colour model, or None."""
-        mask = find_blobs(self.model.mask(frame.rgb), self.config.min_component)
+        mask = find_blobs(self.model.mask(images.rgb), self.config.min_component)
         rows, cols = np.nonzero(mask)
         self._tracking = False
         if rows.size < self.config.min_pixels:
@@ -188,12 +206,12 @@ class VisionDetector(Detector):
         return box, rows, cols
 
     def _place(
-        self, frame: SensorFrame, box, rows: np.ndarray, cols: np.ndarray
+        self, images: RGBD, box: Box, rows: np.ndarray, cols: np.ndarray
     ) -> Detection | None:
         """The detection from the box (px) and the evader's sample pixels, or None when too
         few samples have a depth within range."""
-        k, transform = frame.intrinsics, frame.camera_to_map
-        z = frame.depth[rows, cols].astype(float)
+        k, transform = images.intrinsics, images.camera_to_map
+        z = images.depth[rows, cols].astype(float)
         optical = np.stack(
             [(cols + 0.5 - k[0, 2]) * z / k[0, 0], (rows + 0.5 - k[1, 2]) * z / k[1, 1], z]
         )
@@ -208,7 +226,7 @@ class VisionDetector(Detector):
         surface = np.array([np.median(x[valid]), np.median(y[valid])])
         ray = surface - origin
         position = surface + self.config.surface_offset * ray / max(float(np.hypot(*ray)), 1e-9)
-        height, width = frame.depth.shape
+        height, width = images.depth.shape
         sx, sy = camera.image_width / width, camera.image_height / height
         left, top, right, bottom = box
         return Detection(

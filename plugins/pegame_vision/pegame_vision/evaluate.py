@@ -25,7 +25,7 @@ import math
 import tempfile
 from collections.abc import Iterable, Mapping
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -34,6 +34,13 @@ from pegame.api import Detector
 from pegame.config import compose
 from pegame.game import Game
 from pegame.types import BoundingBox, Detection, Pose, SensorFrame
+
+if TYPE_CHECKING:  # pragma: no cover - typing only (evaluate imports it: sim=pybullet)
+    from pegame_pybullet.sim import PybulletSimulator
+
+#: one judged frame: its kind (positive, negative, ignored), the reference's and the
+#: vision detector's detections, the evader's true pose
+Row = tuple[str, Detection | None, Detection | None, Pose]
 
 
 def iou(a: BoundingBox, b: BoundingBox) -> float:
@@ -49,29 +56,39 @@ class _Judge(Detector):
     """Stands in for the game's detector: returns the reference's detection and records,
     per frame, the vision detector's beside it."""
 
-    def __init__(self, reference, vision, sim, max_range: float, min_visible: float) -> None:
+    def __init__(
+        self,
+        reference: Detector,
+        vision: Detector,
+        sim: PybulletSimulator,
+        max_range: float,
+        min_visible: float,
+    ) -> None:
         super().__init__(reference.config, reference.context, reference.rng)
         self.reference, self.vision, self.sim = reference, vision, sim
         self.max_range, self.min_visible = max_range, min_visible
-        self.rows: list[tuple[str, Detection | None, Detection | None, Pose]] = []
+        self.rows: list[Row] = []
 
     def reset(self) -> None:
         self.reference.reset()
         self.vision.reset()
 
     def detect(self, frame: SensorFrame) -> Detection | None:
+        evader = frame.evader_truth
+        if evader is None:
+            raise RuntimeError("The evaluation needs frames that carry the evader's true pose.")
         truth = self.reference.detect(frame)
         seen = self.vision.detect(frame)
         if truth is None:
             kind = "negative"
         elif (
-            frame.camera_pose.distance_to(frame.evader_truth) <= self.max_range
+            frame.camera_pose.distance_to(evader) <= self.max_range
             and self.sim.evader_visible_fraction() >= self.min_visible
         ):
             kind = "positive"
         else:
             kind = "ignored"
-        self.rows.append((kind, truth, seen, frame.evader_truth))
+        self.rows.append((kind, truth, seen, evader))
         return truth
 
 
@@ -89,6 +106,8 @@ def evaluate(
     ``vision``, defaults otherwise) against ``detector=segmentation`` over S-S games on
     ``env``, one per seed, ``t_max`` s each, the game config changed by ``overrides``
     (e.g. ``sim.camera_tilt=0.3927``); see the module docstring."""
+    from pegame_pybullet.sim import PybulletSimulator
+
     vision_cls = registry.load("detector", "vision")
     vision_config = registry.make_config("detector", vision_cls, dict(vision or {}))
     rows = []
@@ -110,23 +129,26 @@ def evaluate(
                 )
             )
             detector = vision_cls(vision_config, game.context, np.random.default_rng(seed))
-            judge = _Judge(
-                game.plugins.detector, detector, game.plugins.sim, max_range, min_visible
-            )
+            sim = PybulletSimulator.narrow(game.plugins.sim)  # the games' sim=pybullet
+            judge = _Judge(game.plugins.detector, detector, sim, max_range, min_visible)
             game.plugins = replace(game.plugins, detectors=((judge,),))
             game.play(out)
             rows += judge.rows
     return _score(rows, iou_threshold)
 
 
-def _score(rows, iou_threshold: float) -> dict[str, Any]:
+def _score(rows: list[Row], iou_threshold: float) -> dict[str, Any]:
     """The scores of recorded (kind, reference, vision, true evader pose) rows."""
-    positives = [row for row in rows if row[0] == "positive"]
+    positives = [  # a positive frame has the reference's detection
+        (truth, seen, evader)
+        for kind, truth, seen, evader in rows
+        if kind == "positive" and truth is not None
+    ]
     judged = [row for row in rows if row[0] != "ignored" and row[2] is not None]
-    overlaps = [iou(truth.box, seen.box) for _, truth, seen, _ in positives if seen is not None]
+    overlaps = [iou(truth.box, seen.box) for truth, seen, _ in positives if seen is not None]
     matched = [
         (seen, evader)
-        for _, truth, seen, evader in positives
+        for truth, seen, evader in positives
         if seen is not None and iou(truth.box, seen.box) >= iou_threshold
     ]
     errors = [math.hypot(seen.position[0] - e.x, seen.position[1] - e.y) for seen, e in matched]

@@ -10,11 +10,14 @@ spread. Boxes and points are in pixels of the tracked images, (x, y) = (column, 
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
 from pegame_vision.opencv import cv2
 
-LK_PARAMS = {
+LK_PARAMS: dict[str, Any] = {
     "winSize": (9, 9),
     "maxLevel": 2,
     "criteria": (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 20, 0.03),
@@ -27,7 +30,7 @@ class BoxTracker:
     def __init__(self, max_features: int, max_error: float = 1.0) -> None:
         self.max_features = max_features
         self.max_error = max_error
-        self.points = np.zeros((0, 2), dtype=np.float32)
+        self.points: np.ndarray = np.zeros((0, 2), dtype=np.float32)
         self.box = np.zeros(4)  # left, top, right, bottom (px)
         self._gray: np.ndarray | None = None
 
@@ -42,12 +45,12 @@ class BoxTracker:
         self._gray = gray
         return len(self.points)
 
-    def step(self, gray: np.ndarray, accept) -> int:
+    def step(self, gray: np.ndarray, accept: Callable[[np.ndarray], np.ndarray]) -> int:
         """Track into ``gray``; ``accept(points) -> bool (N,)`` is the appearance test.
         Updates the box and the surviving features; returns how many survived."""
         if self._gray is None or len(self.points) == 0:
             return 0
-        old = self.points.reshape(-1, 1, 2)
+        old: np.ndarray = self.points.reshape(-1, 1, 2)
         new, found, _ = cv2.calcOpticalFlowPyrLK(self._gray, gray, old, None, **LK_PARAMS)
         back, found_back, _ = cv2.calcOpticalFlowPyrLK(gray, self._gray, new, None, **LK_PARAMS)
         old, new, back = old.reshape(-1, 2), new.reshape(-1, 2), back.reshape(-1, 2)
