@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import sys
+from collections.abc import Mapping
 from dataclasses import fields
 from importlib.metadata import entry_points
 from importlib.resources import files
@@ -78,7 +79,7 @@ def _defaults_of(config: type) -> dict[str, Any]:
     return {f.name: values[f.name] for f in fields(config)}
 
 
-def merged(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+def merged(base: dict[str, Any], over: Mapping[Any, Any]) -> dict[str, Any]:
     """``over`` merged into ``base`` as OmegaConf.merge merges mappings (a mapping into a
     mapping key by key, any other value replacing), for plain containers."""
     return {

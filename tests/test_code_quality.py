@@ -1,5 +1,5 @@
 """The code keeps the project's habits: ruff's lint rules and format, and mypy over the whole
-package, as configured in pyproject.toml ([tool.ruff], [tool.mypy]); the same checks as
+package and its plugin distributions, as configured in pyproject.toml ([tool.ruff], [tool.mypy]); the same checks as
 .pre-commit-config.yaml, so that README's test command runs them in CI."""
 
 from __future__ import annotations
@@ -38,5 +38,5 @@ def test_ruff_format_check_finds_nothing_to_reformat():
 
 @pytest.mark.slow
 def test_mypy_finds_no_type_errors_in_the_whole_package():
-    proc = run("mypy")  # the files and settings of [tool.mypy]: all of pegame
+    proc = run("mypy")  # the files and settings of [tool.mypy]: pegame and plugins/
     assert proc.returncode == 0, proc.stdout + proc.stderr
