@@ -241,6 +241,8 @@ def wrap_angle(angle: float) -> float:
         wrapped = angle % period  # floored, exact; then onto [-pi, pi]
         if wrapped > math.pi:
             wrapped -= period
+    if wrapped == 0.0:
+        wrapped = math.copysign(0.0, angle)  # the remainder's zero has the angle's sign
     return math.pi if wrapped == -math.pi else wrapped
 
 

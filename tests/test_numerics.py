@@ -133,10 +133,11 @@ def test_wrap_angle_is_pegames_bit_for_bit():
     rng = np.random.default_rng(1)
     angles = rng.uniform(-12.0, 12.0, 20000).tolist()
     pi = math.pi
-    edges = [pi, -pi, 3 * pi, -3 * pi, 2 * pi, 0.0, -0.0, 1e4, -1e4]
+    edges = [pi, -pi, 3 * pi, -3 * pi, 2 * pi, -2 * pi, 48 * pi, -48 * pi, 0.0, -0.0, 1e4, -1e4]
     edges += [math.nextafter(a, b) for a in (pi, -pi, 3 * pi, -3 * pi) for b in (0.0, 10.0)]
     for angle in angles + edges:
-        assert numerics.wrap_angle(angle) == wrap_angle(angle), angle
+        ours, theirs = numerics.wrap_angle(angle), wrap_angle(angle)
+        assert ours == theirs and math.copysign(1.0, ours) == math.copysign(1.0, theirs), angle
 
 
 def test_hypot_shortcuts_answer_as_the_exact_hypot():
