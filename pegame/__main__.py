@@ -131,9 +131,13 @@ def _app(cfg: DictConfig) -> int:
     adopt = adopter(cfg, out_dir, held)
     try:
         sweep_defaults(cfg)
+        multirun = hydra_cfg.mode == RunMode.MULTIRUN
+        cell = f"#{hydra_cfg.job.num} {' '.join(overrides)}".rstrip() if multirun else None
         status = run_job(
-            cfg, out_dir, base_dir=get_original_cwd(), overrides=overrides, adopt=adopt
+            cfg, out_dir, base_dir=get_original_cwd(), overrides=overrides, adopt=adopt, cell=cell
         ).status
+        if not multirun:
+            print(f"output: {out_dir}")
     except PegameError as exc:
         if os.environ.get("HYDRA_FULL_ERROR") == "1":
             raise

@@ -57,6 +57,7 @@ from pegame.config import (
 from pegame.errors import ConfigError, SpawnError
 from pegame.files import write_atomic
 from pegame.grid import OccupancyGrid, load_map, per_grid, read_only
+from pegame.kernel_cache import watch_compilation
 from pegame.loop import GamePlugins, TickLoop, check_team
 from pegame.metrics import TeamMetrics, TrackingMetrics
 from pegame.navigation import Planner
@@ -290,6 +291,7 @@ class Scenario:
     before any game is played. ``base_dir``: where relative map paths are found."""
 
     def __init__(self, cfg: DictConfig, base_dir: str | Path | None = None) -> None:
+        watch_compilation()  # before any game's kernels compile: say so on a cold cache
         self.settings: GameConfig = typed(cfg.game, GameConfig, "game")
         camera: Camera = typed(cfg.camera, Camera, "camera")
         env: EnvConfig = typed(cfg.env, EnvConfig, "env")

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import os
 import sys
 import time
@@ -37,11 +38,11 @@ from typing import Any
 from omegaconf import DictConfig
 
 from pegame import files, sweep
+from pegame.bootstrap import bootstrap_ci
 from pegame.config import check_known_keys
 from pegame.errors import JobDirectoryError, PegameError, ResultsWriteError, SpawnError
 from pegame.game import Game, Outcome, Scenario, pairing, summary_line, write_outcome
 from pegame.joblock import JobLock
-from pegame.kernel_cache import announce_compilation
 from pegame.provenance import config_hash, differing_keys, job_config, provenance
 
 log = logging.getLogger("pegame")
@@ -138,15 +139,19 @@ def run_job(
     base_dir: str | Path | None = None,
     overrides: Sequence[str] = (),
     adopt: Callable[[], None] | None = None,
+    cell: str | None = None,
 ) -> JobRun:
     """Play the job's games into ``out_dir``, holding its lock; ``overrides`` are the
     command-line overrides recorded with every game; ``adopt`` is called once every check
-    passed, before the first game (the app writes Hydra's files and the log then).
+    passed, before the first game (the app writes Hydra's files and the log then); ``cell``
+    names the job at the head of each game line (a sweep's cell, ``#3 env=hall ...``).
+    A job of several games ends with a line of their mean tracking rate and its 95%
+    bootstrap CI.
     PegameError before the first game for a config that cannot be played at all, or a
     directory that belongs to another job; nothing is written to the directory then."""
     out_dir = Path(out_dir)
     with JobLock(out_dir):
-        return _run_locked(cfg, out_dir, base_dir, list(overrides), adopt)
+        return _run_locked(cfg, out_dir, base_dir, list(overrides), adopt, cell)
 
 
 def _run_locked(
@@ -155,6 +160,7 @@ def _run_locked(
     base_dir: str | Path | None,
     overrides: list[str],
     adopt: Callable[[], None] | None,
+    cell: str | None,
 ) -> JobRun:
     scenario = checked_scenario(cfg, base_dir)
     settings = scenario.settings
@@ -196,10 +202,12 @@ def _run_locked(
         run.played.append(outcome.result)
         if single:
             write_single(outcome, game, out_dir)
-        print(summary_line(outcome.result))
+        print(f"{cell}: {summary_line(outcome.result)}" if cell else summary_line(outcome.result))
     if prepared is not None:
         prepared.plugins.sim.close()
     rates = [r["tracking_rate"] for r in run.played]
+    if settings.trials > 1 and rates:
+        print(f"{cell}: {mean_line(rates)}" if cell else mean_line(rates))
     append_line(
         results_path,
         {
@@ -213,12 +221,21 @@ def _run_locked(
     return run
 
 
+def mean_line(rates: list[float]) -> str:
+    """The closing line of a job of several games: their mean tracking rate with its 95%
+    percentile-bootstrap CI (:mod:`pegame.bootstrap`, the report's)."""
+    low, high = bootstrap_ci(rates)
+    return (
+        f"{len(rates)} games: mean tracking rate {100 * math.fsum(rates) / len(rates):.1f}% "
+        f"[{100 * low:.1f}, {100 * high:.1f}] (95% bootstrap CI)"
+    )
+
+
 def checked_scenario(cfg: DictConfig, base_dir: str | Path | None) -> Scenario:
     """The job's scenario, built once: building it checks everything that does not depend
     on the seed (every key, the map, every plugin and its options), so a bad value fails
     here, before any game is played."""
     check_known_keys(cfg)
-    announce_compilation()
     scenario = Scenario(cfg, base_dir)
     check_room_to_spawn(scenario)
     return scenario

@@ -49,6 +49,37 @@ def test_one_game_writes_config_result_trajectory_and_log(tmp_path):
         np.mean([int(r["detected"]) for r in rows]), abs=1e-6
     )
     assert "R-R" in proc.stdout and "hall" in proc.stdout and "tracking rate" in proc.stdout
+    assert proc.stdout.splitlines()[-1] == f"output: {out}"  # where to look, last
+
+
+@pytest.mark.slow
+def test_the_console_names_each_games_cell_and_a_jobs_mean_with_its_ci(tmp_path):
+    proc = run_app(
+        tmp_path,
+        "-m",
+        "game.t_max=4",
+        "recorder=none",
+        "evader=random,smart",
+        "game.trials=2",
+        f"hydra.sweep.dir={tmp_path / 'sweep'}",
+    )
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    for num, evader in ((0, "random"), (1, "smart")):
+        cell = f"#{num} game.t_max=4 recorder=none evader={evader} game.trials=2: "
+        games = [line for line in lines if line.startswith(cell) and "seed" in line]
+        assert len(games) == 2  # every game line names its cell
+        rates = [
+            json.loads(line)["tracking_rate"]
+            for line in (tmp_path / "sweep" / str(num) / "results.jsonl").open()
+            if '"kind": "game"' in line
+        ]
+        mean = next(
+            line for line in lines if line.startswith(cell) and "mean tracking rate" in line
+        )
+        assert f"2 games: mean tracking rate {100 * sum(rates) / 2:.1f}% [" in mean
+        assert mean.endswith("(95% bootstrap CI)")
+    assert not any(line.startswith("output: ") for line in lines)  # a sweep has its own dir
 
 
 @pytest.mark.slow
@@ -240,21 +271,3 @@ def test_a_full_disk_is_one_clear_error_and_the_result_is_printed(tmp_path):
     assert f"Could not write to {tmp_path / 'run' / 'results.jsonl'}: No space left" in proc.stderr
     printed = [line for line in proc.stderr.splitlines() if line.startswith('{"kind": "game"')]
     assert json.loads(printed[0])["map"] == "hall"
-
-
-def test_the_first_run_says_once_that_it_compiles_the_kernels(tmp_path, monkeypatch, caplog):
-    from pegame import job, kernel_cache
-    from pegame.config import compose
-
-    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
-    job.run_job(compose([*FAST, "env=hall"]), tmp_path / "warm")
-    assert not kernel_cache.cache_is_cold()  # numba wrote its cache where pegame looks
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))  # an empty cache: a new install
-    assert kernel_cache.cache_is_cold()
-    kernel_cache.announce_compilation.cache_clear()
-    with caplog.at_level("INFO", logger="pegame"):
-        assert kernel_cache.announce_compilation()
-        kernel_cache.announce_compilation()
-    said = [r.message for r in caplog.records if "compiling pegame's numba kernels" in r.message]
-    assert len(said) == 1 and "half a minute" in said[0]
-    kernel_cache.announce_compilation.cache_clear()

@@ -8,7 +8,7 @@ directory ``run.sh`` and ``factors.sh`` wrote (``table1/<pairing>``, ``added/<fa
 defaults, removed from paper_conditions), pairing and map, the games of the variant are
 paired with the baseline's on common (speed ratio, seed), and the table gives the number
 of pairs, both means, the mean paired difference (variant - baseline, percentage points)
-with its 95% percentile-bootstrap CI (:func:`pegame.report.statistics.bootstrap_ci`), and
+with its 95% percentile-bootstrap CI (:func:`pegame.bootstrap.bootstrap_ci`), and
 a two-sided Wilcoxon signed-rank p (:func:`pegame.report.paired.paired_test`, Pratt's
 zeros), Holm-corrected across the table. Writes ``factor_table.md`` and ``.csv`` beside
 this script.

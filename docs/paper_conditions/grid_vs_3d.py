@@ -21,7 +21,8 @@ from pathlib import Path
 
 from pegame.files import write_atomic
 from pegame.report.paired import paired_test
-from pegame.report.statistics import bootstrap_ci, holm
+from pegame.bootstrap import bootstrap_ci
+from pegame.report.statistics import holm
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from factor_table import MAPS, PAIRINGS, games  # noqa: E402

@@ -441,16 +441,17 @@ class ParticleFilter(Estimator):
 
     def _reinitialise(self, detection: Detection | None, visible: Region) -> Belief:
         """Redraw the lost particle set: around the detection, or uniformly over the free
-        cells outside ``visible`` (all free cells when every one is visible)."""
+        cells outside ``visible`` (all free cells when every one is visible). Said at DEBUG
+        level: it happens many times in some games."""
         if detection is not None:
-            log.info(
+            log.debug(
                 "Particle filter lost the track (no particle near the detection %s); "
                 "redrawing the particles around it.",
                 detection.position,
             )
             self.particles = self._around(detection.position)
         else:
-            log.info(
+            log.debug(
                 "Particle filter weights vanished; redrawing the particles uniformly over "
                 "the free cells outside the pursuer's view."
             )

@@ -47,6 +47,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from pegame.bootstrap import BOOT_LEVEL, BOOT_RESAMPLES, BOOT_SEED, bootstrap_ci
 from pegame.errors import PegameError
 from pegame.files import write_atomic
 from pegame.report.cells import (
@@ -84,14 +85,7 @@ from pegame.report.hypotheses import (
 from pegame.report.load import ReportError, Sweep, find_job_dirs, load_sweep
 from pegame.report.measures import MEASURES, TRACKING, Measure, MeasureError, measure
 from pegame.report.paper import render_paper_csv, render_paper_md, versus_paper
-from pegame.report.statistics import (
-    ALPHA,
-    BOOT_LEVEL,
-    BOOT_RESAMPLES,
-    BOOT_SEED,
-    bootstrap_ci,
-    holm,
-)
+from pegame.report.statistics import ALPHA, holm
 from pegame.report.tables import (
     Layout,
     problem_sections,

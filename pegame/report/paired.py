@@ -14,7 +14,7 @@ seeds common to both sides this module gives
   count as the smallest absolute differences) and then leaves their ranks out of the
   statistic, the conservative choice. All differences zero: W = 0, p = 1 (no evidence);
 - the mean paired difference with its percentile-bootstrap confidence interval over
-  seeds (:func:`~pegame.report.statistics.bootstrap_ci`: the same fixed seed and 10,000
+  seeds (:func:`~pegame.bootstrap.bootstrap_ci`: the same fixed seed and 10,000
   resamples as the cells' intervals);
 - the matched-pairs rank-biserial correlation (Kerby, *Comprehensive Psychology* 3, 2014)
   r = (T+ - T-) / (T+ + T-), from the same Pratt ranks as the test: +1 when every nonzero
@@ -33,8 +33,8 @@ from typing import Any
 import numpy as np
 from scipy.stats import rankdata, wilcoxon
 
+from pegame.bootstrap import bootstrap_ci
 from pegame.report.measures import TRACKING, Measure, is_value
-from pegame.report.statistics import bootstrap_ci
 
 ZERO_METHOD = "pratt"
 TEST_NAME = "Wilcoxon signed-rank on common seeds"

@@ -1,8 +1,8 @@
 """The report's statistics: a cell's description with a bootstrap confidence interval of
 the mean, the one-sided Mann-Whitney U test and the Holm-Bonferroni correction.
 
-- Percentile bootstrap (Efron & Tibshirani, *An Introduction to the Bootstrap*, 1993,
-  ch. 13): 10,000 resamples with a fixed seed, so a report is reproducible.
+- Percentile bootstrap (:mod:`pegame.bootstrap`): 10,000 resamples with a fixed seed, so
+  a report is reproducible.
 - Mann-Whitney U (Mann & Whitney, 1947), :func:`scipy.stats.mannwhitneyu`.
 - Holm's step-down correction (Holm, *Scand. J. Statist.* 6, 1979) of a family of p-values.
 """
@@ -15,31 +15,10 @@ from typing import Any
 import numpy as np
 from scipy.stats import mannwhitneyu
 
+from pegame.bootstrap import bootstrap_ci
+
 ALPHA = 0.05
-BOOT_RESAMPLES = 10_000
-BOOT_LEVEL = 0.95
-BOOT_SEED = 0
 DESCRIBED = ("n", "mean", "ci_low", "ci_high", "median", "std")  # describe()'s keys
-
-
-def bootstrap_ci(
-    values: list[float],
-    resamples: int = BOOT_RESAMPLES,
-    level: float = BOOT_LEVEL,
-    seed: int = BOOT_SEED,
-) -> tuple[float, float]:
-    """Percentile-bootstrap confidence interval of the mean of ``values`` (non-empty)."""
-    x = np.asarray(values, dtype=float)
-    rng = np.random.default_rng(seed)
-    chunk = max(1, 2**20 // x.size)  # bounds memory for large samples
-    means = np.concatenate(
-        [
-            x[rng.integers(0, x.size, size=(min(chunk, resamples - start), x.size))].mean(axis=1)
-            for start in range(0, resamples, chunk)
-        ]
-    )
-    low, high = np.percentile(means, [50 * (1 - level), 50 * (1 + level)])
-    return float(low), float(high)
 
 
 def describe(values: list[float]) -> dict[str, Any]:

@@ -14,9 +14,10 @@ import io
 import re
 from typing import Any
 
+from pegame.bootstrap import BOOT_LEVEL, BOOT_RESAMPLES
 from pegame.report.cells import MAP_ORDER, PAIRING_ORDER, Cell, ordered, value_key, value_text
 from pegame.report.measures import TRACKING, Measure
-from pegame.report.statistics import BOOT_LEVEL, BOOT_RESAMPLES, DESCRIBED
+from pegame.report.statistics import DESCRIBED
 
 MAP_TITLES = {"hall": "Complex Hall", "enclosed": "Enclosed Room", "brick": "Brick Room"}
 
