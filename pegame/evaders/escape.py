@@ -409,14 +409,13 @@ class EscapeSearch:
         if count == 0:
             return Escape(-1, math.inf, 0, np.zeros(0, dtype=np.int64))
         bounds, effort, dist = self._bounds(component, me, pursuer)
-        arguments = (
-            bounds,
-            TiledCells(
-                component.starts, component.rows, component.cols, grid.kernel_frame, grid.width
-            ),
-            Window(exposed, top, left),
-            Costs((me.x, me.y, pursuer.x, pursuer.y), effort, dist),
+        cells = TiledCells(
+            component.starts, component.rows, component.cols, grid.kernel_frame, grid.width
         )
+        costs = Costs((me.x, me.y, pursuer.x, pursuer.y), effort, dist)
+        # Plain tuples for the kernel: numba types a NamedTuple argument in Python, each
+        # of its fields again (microseconds with a nested tuple), a plain tuple in C.
+        arguments = (bounds, tuple(cells), tuple(Window(exposed, top, left)), tuple(costs))
         # Tiles in increasing bound, the FIRST_TILES lowest sorted first: the search
         # nearly always stops among them, and sorting every tile of a large map is most
         # of a decision. The rest follow (sorted) only when it did not.

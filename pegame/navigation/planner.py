@@ -149,12 +149,15 @@ class Planner:
         self._nearest: np.ndarray | None = None  # see _nearest_cells
         self._padded_width = grid.width + 2
         self._allowed = allowed_moves(self.traversable)
-        self._lattice = Lattice(
-            self._allowed, self._padded_multipliers, grid.resolution, self._padded_width, MOVES
+        # The kernels' structures as plain tuples (see pegame.navigation.search).
+        self._lattice = tuple(
+            Lattice(
+                self._allowed, self._padded_multipliers, grid.resolution, self._padded_width, MOVES
+            )
         )
         # Search scratch memory, allocated at the first search that needs it.
-        self._astar_scratch: AStarScratch | None = None
-        self._bucket_pool: BucketPool | None = None
+        self._astar_scratch: tuple | None = None
+        self._bucket_pool: tuple | None = None
         self.landmarks = int(landmarks)
         if tie_quantum is None:
             tie_quantum = TIE_QUANTUM if grid.data.size >= LARGE_GRID_CELLS else 0.0
@@ -233,11 +236,11 @@ class Planner:
             if self._bucket_pool is None:
                 # Cells usually enter the queue about once; start at 2 n + 1 entries and
                 # grow to the bound 8 n + 1 only if a search runs out.
-                self._bucket_pool = BucketPool.empty(2 * n + 1)
+                self._bucket_pool = tuple(BucketPool.empty(2 * n + 1))
             dist, complete = dijkstra(self._lattice, weighted, self._flat(cell), self._bucket_pool)
             if complete:
                 return dist.reshape(self.grid.height + 2, self._padded_width)[1:-1, 1:-1]
-            self._bucket_pool = BucketPool.empty(8 * n + 1)
+            self._bucket_pool = tuple(BucketPool.empty(8 * n + 1))
 
     def _landmark_table(self) -> np.ndarray:
         """Float32 (landmarks, n): weighted path costs (m) from each landmark cell to every
@@ -281,12 +284,12 @@ class Planner:
             self._landmarks = read_only(costs)
         return self._landmarks
 
-    def _search_scratch(self) -> AStarScratch:
+    def _search_scratch(self) -> tuple:
         """A*'s scratch arrays, seen all False between searches. All are left uninitialised
         or zeroed by the system (see search.astar), so a search uses the memory of the
         cells it reaches only."""
         if self._astar_scratch is None:
-            self._astar_scratch = AStarScratch.empty(self._allowed.size)
+            self._astar_scratch = tuple(AStarScratch.empty(self._allowed.size))
         return self._astar_scratch
 
     def _snap_goal(self, goal_xy: XY, label: int) -> tuple[int, int] | None:
@@ -336,7 +339,7 @@ class Planner:
                 if not self.grid.contains(row, col):
                     return _unreachable("goal is outside the map")
                 return _unreachable("goal is inside an obstacle")
-        heuristic = Heuristic(self._landmark_table(), self.tie_quantum)
+        heuristic = tuple(Heuristic(self._landmark_table(), self.tie_quantum))
         cost, cells, searched = astar(
             self._lattice, self._flat(start), self._flat(goal), heuristic, self._search_scratch()
         )

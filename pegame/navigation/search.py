@@ -15,7 +15,9 @@ a bucket queue, :func:`astar` A* with an indexed binary heap; the plain-Python
 :func:`distance_field_reference` and :func:`astar_reference` (heapq on (row, col) cells)
 implement the same algorithms for the tests to compare against. The kernels take their
 arrays grouped by meaning (:class:`Lattice`, :class:`Heuristic`, :class:`AStarScratch`,
-:class:`BucketPool`) and unpack them once at entry.
+:class:`BucketPool`) and unpack them once at entry; the planner passes them as plain
+tuples of those fields, which numba types in C (a NamedTuple argument it types in Python,
+field by field: about 0.6 us a call).
 """
 
 from __future__ import annotations
