@@ -2,11 +2,11 @@
 
 Exit status: 0 when every game of every job finished, 1 when some games failed (their
 records and the other games are written), 2 for bad input. A single run knows its status
-in-process. In a multirun the jobs may run in other processes (the joblib launcher's loky
-workers, submitit), and Hydra 1.3 drops what a job returns, so the sweep's process
-creates a status directory in the sweep dir when the multirun starts
-(:func:`start_sweep`), each job writes its status there (:func:`job_ended`), and the
-sweep's process reads them when the multirun ends (:func:`end_sweep`).
+in-process. In a multirun the jobs may run in other processes (the workers of pegame's
+launcher or of the joblib launcher, submitit), and Hydra 1.3 drops what a job returns,
+so the sweep's process creates a status directory in the sweep dir when the multirun
+starts (:func:`start_sweep`), each job writes its status there (:func:`job_ended`), and
+the sweep's process reads them when the multirun ends (:func:`end_sweep`).
 
 One owner per sweep directory: :func:`start_sweep` takes an exclusive ``flock`` on
 ``<sweep dir>/.pegame-sweep``, which records the owner (PID, start time, command line),
@@ -172,9 +172,9 @@ def end_broken_sweep() -> Path | None:
 
 def sweep_parent() -> int | None:
     """The sweep process's PID when this process is one of its worker processes (a direct
-    child, as loky and submitit-local workers are), else None: a single run or a job run
-    in the sweep's own process has no parent to watch, and a job on another machine
-    (slurm) has a parent that is not the sweep's process."""
+    child, as the workers of pegame's launcher, loky's and submitit-local's are), else
+    None: a single run or a job run in the sweep's own process has no parent to watch, and
+    a job on another machine (slurm) has a parent that is not the sweep's process."""
     recorded = os.environ.get(SWEEP_PID_ENV)
     if recorded and recorded.isdigit():
         pid = int(recorded)

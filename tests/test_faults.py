@@ -310,13 +310,17 @@ def workers_of(pid: int) -> list[int]:
 
 
 @pytest.mark.slow
-def test_a_killed_worker_ends_the_sweep_with_a_report_of_what_finished_and_exit_1(tmp_path):
-    # joblib's TerminatedWorkerError ended the sweep with exit 1, no report, no word on resume
+def test_a_killed_joblib_worker_ends_the_sweep_with_a_report_of_what_finished_and_exit_1(
+    tmp_path,
+):
+    # joblib's TerminatedWorkerError ended the sweep with exit 1, no report, no word on resume;
+    # joblib cancels the jobs it had not finished (pegame's launcher fails the killed job
+    # only: tests/test_launcher.py)
     sweep = tmp_path / "sweep"
     args = [
         "-m", "recorder=none", "env=hall", "game.t_max=4", "game.trials=60",
-        "pursuer=random", "evader=random,smart", "hydra.launcher.n_jobs=2",
-        f"hydra.sweep.dir={sweep}",
+        "pursuer=random", "evader=random,smart", "hydra/launcher=joblib",
+        "hydra.launcher.n_jobs=2", f"hydra.sweep.dir={sweep}",
     ]  # fmt: skip
     proc = app(tmp_path, *args, env={"PYTHONUNBUFFERED": "1"})
     for line in proc.stdout:  # a job prints each game's line once it is stored
