@@ -227,9 +227,9 @@ class Costs(NamedTuple):
 def _best_candidate(
     tiles: np.ndarray,
     bounds: np.ndarray,
-    cells: TiledCells,
-    exposed: Window,
-    costs: Costs,
+    cells: tuple,
+    exposed: tuple,
+    costs: tuple,
     best: tuple[int, float],
 ) -> tuple[int, float, bool]:
     """Algorithm 2's argmin over the ``cells`` of ``tiles`` outside the ``exposed`` window

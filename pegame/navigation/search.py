@@ -128,9 +128,7 @@ def allowed_moves(traversable: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def dijkstra(
-    lattice: Lattice, weighted: bool, source: int, pool: BucketPool
-) -> tuple[np.ndarray, bool]:
+def dijkstra(lattice: tuple, weighted: bool, source: int, pool: tuple) -> tuple[np.ndarray, bool]:
     """Least path cost (m) over ``lattice`` from flat cell ``source`` to every cell, inf if
     unreachable; each step's length times its cells' mean multiplier when ``weighted``.
 
@@ -273,7 +271,7 @@ def _octile(resolution: float, row: int, col: int, goal_row: int, goal_col: int)
 
 @njit(cache=True)
 def astar(
-    lattice: Lattice, start: int, goal: int, heuristic: Heuristic, scratch: AStarScratch
+    lattice: tuple, start: int, goal: int, heuristic: tuple, scratch: tuple
 ) -> tuple[float, np.ndarray, int]:
     """Minimum weighted cost (m), flat cell path and number of cells reached over
     ``lattice`` from flat cell ``start`` to ``goal`` by A*.
