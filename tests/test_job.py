@@ -177,8 +177,9 @@ def run_sweep(tmp_path: Path, *overrides: str) -> subprocess.CompletedProcess:
 
 
 @pytest.mark.slow
-def test_multirun_through_joblib_writes_every_job_and_the_report(tmp_path):
-    proc = run_sweep(tmp_path)
+@pytest.mark.parametrize("launcher", ["pegame", "joblib"])
+def test_a_multirun_writes_every_job_and_the_report(tmp_path, launcher):
+    proc = run_sweep(tmp_path, f"hydra/launcher={launcher}")
     assert proc.returncode == 0, proc.stderr
     results = sorted((tmp_path / "sweep").rglob("results.jsonl"))
     assert len(results) == 4
