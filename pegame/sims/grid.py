@@ -51,17 +51,26 @@ def _ramp(current: float, target: float, limit: float) -> float:
 
 
 def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
-    """Exact unicycle integration of (v, w) held for dt seconds from ``pose``.
+    """Exact unicycle integration of (v, w) held for dt seconds from ``pose``: the circular
+    arc of radius v / w (a straight line below 1e-9 rad/s).
 
-    The arc's chord, v dt sin(h) / h long for the half turn h = w dt / 2, along the mean
-    heading theta + h: accurate to round-off for every turn rate (the difference of sines
-    times v / w, the textbook form, loses digits to cancellation as w nears 0).
+    Known limit, kept so that games stay bit for bit those of the committed studies: the
+    difference of sines times v / w loses digits to cancellation when w is just above
+    1e-9 rad/s: the sines' and the end heading's rounding, times |v / w| (2.2e-8 m on a
+    0.1 m step at w = 2.3e-9 rad/s; tests/sims/test_grid_properties.py derives the bound
+    and holds the move to it). The
+    chord form v dt sin(h) / h along theta + h, h = w dt / 2, is accurate for every w,
+    and changes the last bits of every turning move: it belongs to a release that may
+    change games.
     """
-    half = 0.5 * cmd.w * dt
-    chord = cmd.v * dt * (math.sin(half) / half if half != 0.0 else 1.0)
-    heading = pose.theta + half
-    dx, dy = chord * math.cos(heading), chord * math.sin(heading)
-    return Pose(pose.x + dx, pose.y + dy, wrap_angle(pose.theta + cmd.w * dt))
+    theta = pose.theta + cmd.w * dt
+    if abs(cmd.w) < 1e-9:
+        dx, dy = cmd.v * dt * math.cos(pose.theta), cmd.v * dt * math.sin(pose.theta)
+    else:
+        radius = cmd.v / cmd.w
+        dx = radius * (math.sin(theta) - math.sin(pose.theta))
+        dy = -radius * (math.cos(theta) - math.cos(pose.theta))
+    return Pose(pose.x + dx, pose.y + dy, wrap_angle(theta))
 
 
 @njit(cache=True)

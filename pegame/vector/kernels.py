@@ -99,9 +99,12 @@ def move(
         v = _ramp(velocities[game, role, 0], v, a_max * dt)
         w = _ramp(velocities[game, role, 1], w, alpha_max * dt)
     theta = theta0 + w * dt
-    half = 0.5 * w * dt  # the arc of pegame.sims.grid.unicycle, operation for operation
-    chord = v * dt * (math.sin(half) / half if half != 0.0 else 1.0)
-    dx, dy = chord * math.cos(theta0 + half), chord * math.sin(theta0 + half)
+    if abs(w) < 1e-9:  # the arc of pegame.sims.grid.unicycle, operation for operation
+        dx, dy = v * dt * math.cos(theta0), v * dt * math.sin(theta0)
+    else:
+        radius = v / w
+        dx = radius * (math.sin(theta) - math.sin(theta0))
+        dy = -radius * (math.cos(theta) - math.cos(theta0))
     tx, ty = x0 + dx, y0 + dy
     n = max(1, ceil_of_hypot(tx - x0, ty - y0, frame[RESOLUTION]))
     x, y = _sweep(masks[role], x0, y0, tx, ty, n, frame)
