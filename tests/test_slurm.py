@@ -100,6 +100,7 @@ def test_cluster_runs_a_job(slurm):
     assert words[0::2] == ["job", "on"] and words[1].isdigit() and words[3] == slurm.node, words
 
 
+@pytest.mark.slow
 def test_paper_table1_sweep_on_slurm_matches_local(slurm, tmp_path, record_property):
     local_dir, slurm_dir = tmp_path / "local", tmp_path / "slurm"
     local_s = run_sweep(tmp_path / "cwd_local", local_dir, "hydra/launcher=joblib")
