@@ -293,6 +293,7 @@ def play(overrides: list[str], seed: int = 0) -> dict:
     return Game(compose([*base, *overrides])).play("unused").result
 
 
+@pytest.mark.slow
 def test_a_game_with_every_part_on_plays_the_same_for_the_same_seed_and_differs_from_the_oracle():
     slow = play(PAPER_LIKE)
     assert slow == play(PAPER_LIKE)
