@@ -80,6 +80,12 @@ def test_the_console_names_each_games_cell_and_a_jobs_mean_with_its_ci(tmp_path)
         assert f"2 games: mean tracking rate {100 * sum(rates) / 2:.1f}% [" in mean
         assert mean.endswith("(95% bootstrap CI)")
     assert not any(line.startswith("output: ") for line in lines)  # a sweep has its own dir
+    progress = [line for line in lines if line.startswith("pegame: cell ")]
+    assert [line.split(" done ")[0] for line in progress] == [
+        "pegame: cell 1 of 2",
+        "pegame: cell 2 of 2",
+    ]
+    assert all(": exit 0, " in line for line in progress)  # one line per cell, as it ends
 
 
 @pytest.mark.slow
