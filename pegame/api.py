@@ -286,13 +286,22 @@ class Simulator(Plugin):
 
     @abstractmethod
     def reset(self, pursuer: Pose, evader: Pose) -> None:
-        """Place both agents at the given map-frame poses."""
+        """Place both agents at the given map-frame poses.
+
+        :param pursuer: the pursuer's pose (m, m, rad), in the map frame.
+        :param evader: the evader's pose (m, m, rad), in the map frame.
+        """
 
     @abstractmethod
     def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
         """Advance dt seconds with both commands held; commands beyond an agent's limits
         are saturated (speed, turn rate and, when finite, the bodies' ``a_max`` and
-        ``alpha_max``), and an agent never enters an obstacle (it stops at the wall)."""
+        ``alpha_max``), and an agent never enters an obstacle (it stops at the wall).
+
+        :param pursuer_cmd: the pursuer's (v m/s, w rad/s), held for ``dt``.
+        :param evader_cmd: the evader's (v m/s, w rad/s), held for ``dt``.
+        :param dt: the period (s), ``context.control_dt`` divided by the physics substeps.
+        """
 
     def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
         """Advance only ``role`` ('pursuer' or 'evader') dt seconds with ``cmd`` held, the
@@ -308,7 +317,12 @@ class Simulator(Plugin):
 
     @abstractmethod
     def sense(self, time: float) -> SensorFrame:
-        """The pursuer camera's frame at simulation time ``time`` (s)."""
+        """The pursuer camera's frame at simulation time ``time`` (s).
+
+        :param time: the simulated time of the frame (s), the tick's.
+        :returns: the camera's pose and whatever the simulator renders (ground-truth
+            evader pose for the oracle; RGB, depth and segmentation for a 3D simulator).
+        """
 
     def close(self) -> None:
         """Release resources (connections, windows). Called once per game."""
@@ -329,7 +343,12 @@ class Detector(Plugin):
 
     @abstractmethod
     def detect(self, frame: SensorFrame) -> Detection | None:
-        """Detect the evader in ``frame``; None when it is not seen."""
+        """Detect the evader in ``frame``; None when it is not seen.
+
+        :param frame: the pursuer camera's frame of this tick (``Simulator.sense``).
+        :returns: the detection (image box in px, map-frame position in m, depth in m,
+            confidence), or None.
+        """
 
     def reset(self) -> None:
         """Forget any tracking state; called at the start of each game."""
@@ -344,7 +363,13 @@ class Estimator(Plugin):
 
     @abstractmethod
     def reset(self, pursuer: Pose, detection: Detection | None, region: Region) -> Belief:
-        """Start a new game; the evader is in view at the start (the paper's protocol)."""
+        """Start a new game; the evader is in view at the start (the paper's protocol).
+
+        :param pursuer: the pursuer's pose (map frame).
+        :param detection: the first tick's detection, or None when the detector missed.
+        :param region: the cells the pursuer sees at that pose (its visibility region).
+        :returns: the initial belief about the evader's position.
+        """
 
     @abstractmethod
     def update(
@@ -353,7 +378,15 @@ class Estimator(Plugin):
         """Predict dt seconds (s) ahead and correct with this tick's detection (or its
         absence) and the pursuer's visibility region (``region.mask`` is a bool (H, W) mask
         over the grid; ``region.holds(cells)`` answers for a few cells, at a fraction of
-        the cost)."""
+        the cost).
+
+        :param dt: the time since the last update (s), one control period.
+        :param pursuer: the pursuer's pose at this tick (map frame).
+        :param detection: this tick's detection, or None (negative information: the evader
+            is not in ``region``, unless the detector missed it).
+        :param region: the cells the pursuer sees (its visibility region, or a team's union).
+        :returns: the belief about the evader's position after this tick.
+        """
 
     def reset_team(
         self, pursuers: Sequence[Pose], detections: Sequence[Detection | None], region: Region
@@ -412,15 +445,27 @@ class Strategy(Plugin, Generic[ObservationT]):
 
     @abstractmethod
     def reset(self, pose: Pose) -> None:
-        """Start a new game at ``pose``."""
+        """Start a new game at ``pose``.
+
+        :param pose: this agent's starting pose (m, m, rad), in the map frame.
+        """
 
     @abstractmethod
     def decide(self, observation: ObservationT) -> Plan:
-        """Choose what to do until the next decision (called at decision_hz)."""
+        """Choose what to do until the next decision (called at decision_hz).
+
+        :param observation: what the role may know at this tick
+            (:class:`PursuerObservation` or :class:`EvaderObservation`).
+        :returns: the plan: a goal (m) and a path to it, and ``info`` for the recording.
+        """
 
     @abstractmethod
     def control(self, observation: ObservationT) -> Velocity:
-        """The velocity command for the next control period (called at control_hz)."""
+        """The velocity command for the next control period (called at control_hz).
+
+        :param observation: what the role may know at this tick.
+        :returns: (v m/s, w rad/s); the simulator saturates it to the body's limits.
+        """
 
 
 class Pursuer(Strategy[PursuerObservation]):
@@ -470,11 +515,20 @@ class Recorder(Plugin):
 
     @abstractmethod
     def start(self, out_dir: str, game_id: str, properties: dict[str, Any]) -> None:
-        """Begin a recording for one game in ``out_dir``; ``properties`` is the run config."""
+        """Begin a recording for one game in ``out_dir``; ``properties`` is the run config.
+
+        :param out_dir: the job's directory, where the recording is written.
+        :param game_id: the game's name in it (``game``, or ``game_<seed>`` in a job of
+            several games).
+        :param properties: the run's config, flattened to dotted keys.
+        """
 
     @abstractmethod
     def log(self, tick: Tick) -> None:
-        """Log one control tick."""
+        """Log one control tick.
+
+        :param tick: the tick's true poses, frame, detection, belief, region and plans.
+        """
 
     @abstractmethod
     def finish(self, result: dict[str, Any]) -> None:
