@@ -30,7 +30,13 @@ from pegame.report.cells import AXES, Cell, file_safe, value_text
 from pegame.report.measures import MEASURES, TRACKING, Measure
 from pegame.report.paired import TEST_NAME, by_seed, difference_text, paired_test
 from pegame.report.statistics import ALPHA, holm
-from pegame.report.tables import csv_value
+from pegame.report.tables import (
+    CELL_COLUMNS,
+    CELL_CSV_COLUMNS,
+    cell_texts,
+    cell_values,
+    markdown_rows,
+)
 
 STATS = [
     "n_a",
@@ -176,9 +182,7 @@ def render_compare_md(comparison: dict[str, Any]) -> str:
     unit = "percentage points" if measure.is_rate else measure.unit or "its own units"
     header = [
         *comparison["others"],
-        "environment",
-        "v_p/v_e",
-        "pairing",
+        *CELL_COLUMNS,
         "pairs",
         f"mean ({a})",
         f"mean ({b})",
@@ -205,24 +209,26 @@ def render_compare_md(comparison: dict[str, Any]) -> str:
         f"{summary['significant']} of {summary['tested']} tested cells ({summary['cells']} "
         f"compared).",
         "",
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
+        *markdown_rows(
+            header,
+            [
+                [
+                    *cell_texts(row),
+                    f"{row['n_pairs']} (of {row['n_a']}, {row['n_b']})",
+                    *(
+                        "–" if row[k] is None else measure.shown(row[k])
+                        for k in ("mean_a", "mean_b")
+                    ),
+                    difference_text(row, measure),
+                    number(row["rank_biserial"], "+.2f"),
+                    number(row["W"], "g"),
+                    number(row["p"], ".3g"),
+                    number(row["p_holm"], ".3g"),
+                ]
+                for row in comparison["rows"]
+            ],
+        ),
     ]
-    for row in comparison["rows"]:
-        texts = [
-            *(value_text(v) for v in row["factors"].values()),
-            row["map"],
-            value_text(row["speed_ratio"]),
-            row["pairing"],
-            f"{row['n_pairs']} (of {row['n_a']}, {row['n_b']})",
-            *("–" if row[k] is None else measure.shown(row[k]) for k in ("mean_a", "mean_b")),
-            difference_text(row, measure),
-            number(row["rank_biserial"], "+.2f"),
-            number(row["W"], "g"),
-            number(row["p"], ".3g"),
-            number(row["p_holm"], ".3g"),
-        ]
-        lines.append("| " + " | ".join(texts) + " |")
     return "\n".join(lines) + "\n"
 
 
@@ -231,15 +237,7 @@ def render_compare_csv(comparison: dict[str, Any]) -> str:
     :data:`STATS`; rates as fractions, empty where not tested."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow([*comparison["others"], "map", "speed_ratio", "pairing", *STATS])
+    writer.writerow([*comparison["others"], *CELL_CSV_COLUMNS, *STATS])
     for row in comparison["rows"]:
-        writer.writerow(
-            [
-                *(csv_value(v) for v in row["factors"].values()),
-                row["map"],
-                row["speed_ratio"],
-                row["pairing"],
-                *("" if row[s] is None else row[s] for s in STATS),
-            ]
-        )
+        writer.writerow([*cell_values(row), *("" if row[s] is None else row[s] for s in STATS)])
     return buffer.getvalue()

@@ -15,10 +15,17 @@ import csv
 import io
 from typing import Any
 
-from pegame.report.cells import Cell, value_text
+from pegame.report.cells import Cell
 from pegame.report.measures import MEASURES, values
 from pegame.report.statistics import describe
-from pegame.report.tables import cell_text, csv_value
+from pegame.report.tables import (
+    CELL_COLUMNS,
+    CELL_CSV_COLUMNS,
+    cell_text,
+    cell_texts,
+    cell_values,
+    markdown_rows,
+)
 
 ESTIMATION = [MEASURES[name] for name in ("mean_estimation_error", "n_eff_mean", "resamplings")]
 CARRIED = ("mean_estimation_error", "n_eff_mean")  # what makes the table worth writing
@@ -54,11 +61,13 @@ def render_estimation_md(table: dict[str, Any]) -> str:
     """estimation.md: one row per cell, a column per measure."""
     header = [
         *table["factors"],
-        "environment",
-        "v_p/v_e",
-        "pairing",
+        *CELL_COLUMNS,
         "games",
         *(f"{m.axis_label()} [CI] n" for m in ESTIMATION),
+    ]
+    rows = [
+        [*cell_texts(row), str(row["games"]), *(cell_text(row[m.name], m) for m in ESTIMATION)]
+        for row in table["rows"]
     ]
     lines = [
         "# The estimator: error while unseen, N_eff and resampling",
@@ -69,19 +78,8 @@ def render_estimation_md(table: dict[str, Any]) -> str:
         "particle filter's mean effective sample size N_eff = 1 / sum(w_i^2) (none for an "
         "estimator without particles) and the resamplings per game.",
         "",
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
+        *markdown_rows(header, rows),
     ]
-    for row in table["rows"]:
-        texts = [
-            *(value_text(v) for v in row["factors"].values()),
-            row["map"],
-            f"{row['speed_ratio']:g}",
-            row["pairing"],
-            str(row["games"]),
-            *(cell_text(row[m.name], m) for m in ESTIMATION),
-        ]
-        lines.append("| " + " | ".join(texts) + " |")
     return "\n".join(lines) + "\n"
 
 
@@ -91,20 +89,12 @@ def render_estimation_csv(table: dict[str, Any]) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     columns = [f"{name}_{s}" for name in table["measures"] for s in STATS]
-    writer.writerow([*table["factors"], "map", "speed_ratio", "pairing", "games", *columns])
+    writer.writerow([*table["factors"], *CELL_CSV_COLUMNS, "games", *columns])
     for row in table["rows"]:
-        writer.writerow(
-            [
-                *(csv_value(v) for v in row["factors"].values()),
-                row["map"],
-                row["speed_ratio"],
-                row["pairing"],
-                row["games"],
-                *(
-                    "" if row[name][s] is None else row[name][s]
-                    for name in table["measures"]
-                    for s in STATS
-                ),
-            ]
-        )
+        stats = [
+            "" if row[name][s] is None else row[name][s]
+            for name in table["measures"]
+            for s in STATS
+        ]
+        writer.writerow([*cell_values(row), row["games"], *stats])
     return buffer.getvalue()

@@ -19,9 +19,16 @@ import math
 from importlib.resources import files
 from typing import Any
 
-from pegame.report.cells import Cell, facets, value_text
+from pegame.report.cells import Cell, facets
 from pegame.report.hypotheses import facet_text
-from pegame.report.tables import cell_text, csv_value
+from pegame.report.tables import (
+    CELL_COLUMNS,
+    CELL_CSV_COLUMNS,
+    cell_text,
+    cell_texts,
+    cell_values,
+    markdown_rows,
+)
 
 PAPER_FILE = "paper_table1.csv"
 Place = tuple[str, float, str]  # (map, speed_ratio, pairing)
@@ -90,13 +97,21 @@ def render_paper_md(versus: dict[str, Any]) -> str:
     """vs_paper.md: one row per cell on the paper's axes, the summaries, what is left out."""
     header = [
         *versus["factors"],
-        "environment",
-        "v_p/v_e",
-        "pairing",
+        *CELL_COLUMNS,
         "ours [CI] n",
         "paper",
         "ours - paper",
         "paper in our CI",
+    ]
+    rows = [
+        [
+            *cell_texts(row),
+            cell_text(row),
+            f"{100 * row['paper_mean']:.2f}%",
+            f"{100 * row['difference']:+.1f} pp",
+            "yes" if row["paper_inside_ci"] else "no",
+        ]
+        for row in versus["rows"]
     ]
     lines = [
         "# Tracking rate: ours beside the paper's Table 1",
@@ -106,21 +121,8 @@ def render_paper_md(versus: dict[str, Any]) -> str:
         "spread), the difference in percentage points and whether the paper's mean lies "
         "inside our CI.",
         "",
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
+        *markdown_rows(header, rows),
     ]
-    for row in versus["rows"]:
-        texts = [
-            *(value_text(v) for v in row["factors"].values()),
-            row["map"],
-            f"{row['speed_ratio']:g}",
-            row["pairing"],
-            cell_text(row),
-            f"{100 * row['paper_mean']:.2f}%",
-            f"{100 * row['difference']:+.1f} pp",
-            "yes" if row["paper_inside_ci"] else "no",
-        ]
-        lines.append("| " + " | ".join(texts) + " |")
     lines += ["", "## Summary", ""]
     for s in versus["summaries"]:
         where = f" ({facet_text(s['factors'])})" if s["factors"] else ""
@@ -140,15 +142,7 @@ def render_paper_csv(versus: dict[str, Any]) -> str:
     (fractions)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow([*versus["factors"], "map", "speed_ratio", "pairing", *STATS])
+    writer.writerow([*versus["factors"], *CELL_CSV_COLUMNS, *STATS])
     for row in versus["rows"]:
-        writer.writerow(
-            [
-                *(csv_value(v) for v in row["factors"].values()),
-                row["map"],
-                row["speed_ratio"],
-                row["pairing"],
-                *(row[s] for s in STATS),
-            ]
-        )
+        writer.writerow([*cell_values(row), *(row[s] for s in STATS)])
     return buffer.getvalue()

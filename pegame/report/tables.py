@@ -112,6 +112,35 @@ def csv_value(value: Any) -> Any:
     )
 
 
+#: the columns that name a row of a per-cell table (estimation, vs_paper, compare) after
+#: its other factors: in Markdown, and in CSV
+CELL_COLUMNS = ("environment", "v_p/v_e", "pairing")
+CELL_CSV_COLUMNS = ("map", "speed_ratio", "pairing")
+
+
+def cell_texts(row: dict[str, Any]) -> list[str]:
+    """The Markdown texts that name a per-cell row: its other factors' values, then
+    :data:`CELL_COLUMNS`."""
+    factors = [value_text(v) for v in row["factors"].values()]
+    return [*factors, row["map"], value_text(row["speed_ratio"]), row["pairing"]]
+
+
+def cell_values(row: dict[str, Any]) -> list[Any]:
+    """The CSV values that name a per-cell row: its other factors, then
+    :data:`CELL_CSV_COLUMNS`."""
+    factors = [csv_value(v) for v in row["factors"].values()]
+    return [*factors, row["map"], row["speed_ratio"], row["pairing"]]
+
+
+def markdown_rows(header: list[str], rows: list[list[str]]) -> list[str]:
+    """A Markdown table's lines: the header, its rule, one line per row of texts."""
+    return [
+        "| " + " | ".join(header) + " |",
+        "|" + "---|" * len(header),
+        *("| " + " | ".join(texts) + " |" for texts in rows),
+    ]
+
+
 def render_table_csv(cells: list[Cell], described: list[dict[str, Any]]) -> str:
     """One row per cell: map, speed_ratio, pairing, the other factors, statistics; rates as
     fractions."""
