@@ -23,6 +23,7 @@ from pegame.policies import LinearPolicy
 from pegame.recorders.files import recording_status
 from pegame.sweep import OWNER_FILE
 from pegame.testing import chase
+from pegame.testing.processes import loky_workers
 
 FAST = ["recorder=none", "env=hall", "game.t_max=2"]
 RANDOM = ["pursuer=random", "evader=random"]
@@ -295,20 +296,6 @@ def test_a_results_file_with_bytes_that_are_no_utf8_still_resumes(tmp_path):
 # --- a worker killed -----------------------------------------------------------------
 
 
-def workers_of(pid: int) -> list[int]:
-    """The live child processes of ``pid`` that run pegame jobs (loky's workers)."""
-    found = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-            command = (stat.parent / "cmdline").read_bytes()
-        except OSError:
-            continue
-        if int(fields[1]) == pid and fields[0] != "Z" and b"popen_loky" in command:
-            found.append(int(stat.parent.name))
-    return found
-
-
 @pytest.mark.slow
 def test_a_killed_joblib_worker_ends_the_sweep_with_a_report_of_what_finished_and_exit_1(
     tmp_path,
@@ -326,7 +313,7 @@ def test_a_killed_joblib_worker_ends_the_sweep_with_a_report_of_what_finished_an
     for line in proc.stdout:  # a job prints each game's line once it is stored
         if " on hall: tracking rate " in line:
             break
-    victims = workers_of(proc.pid)
+    victims = loky_workers(proc.pid)
     assert victims, "no loky worker found"
     os.kill(victims[0], 9)
     status, err = finished(proc)

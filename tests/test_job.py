@@ -19,6 +19,7 @@ from pegame import job
 from pegame.config import compose
 from pegame.errors import JobDirectoryError, ResultsWriteError
 from pegame.joblock import JobLock, JobLockedError
+from pegame.testing.processes import loky_workers
 
 SHORT = ["game.t_max=4", "recorder=none", "env=hall"]
 RANDOM = ["pursuer=random", "evader=random"]
@@ -243,21 +244,6 @@ def games_stored(tmp_path: Path) -> list[int]:
     return [sum(1 for e in job.read_lines(f) if e.get("kind") == "game") for f in files]
 
 
-def children(pid: int) -> list[int]:
-    """Live (not zombie) loky worker processes whose parent is ``pid`` (not loky's
-    resource tracker, which runs no job)."""
-    found = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-            command = (stat.parent / "cmdline").read_bytes()
-        except OSError:
-            continue
-        if int(fields[1]) == pid and fields[0] != "Z" and b"popen_loky" in command:
-            found.append(int(stat.parent.name))
-    return found
-
-
 def wait_for_games(proc: subprocess.Popen, per_job: int) -> None:
     """Block until both jobs of the sweep printed ``per_job`` games: a job prints a game's
     summary line after storing it, so this waits on the sweep's own output, not on time.
@@ -292,7 +278,7 @@ def interrupt_mid_sweep(tmp_path: Path, how, sigint_ignored: bool = False) -> li
     ``how(proc)``; return the worker PIDs it had."""
     proc = start_sweep(tmp_path, sigint_ignored=sigint_ignored)
     wait_for_games(proc, per_job=2)
-    workers = children(proc.pid)
+    workers = loky_workers(proc.pid)
     assert len(workers) >= 2
     how(proc)
     proc.wait(timeout=300)
