@@ -28,7 +28,7 @@ def map_shades(grid: OccupancyGrid) -> np.ndarray:
     return np.where(grid.data < 0, 0.6, 1.0 - 0.75 * occupancy)
 
 
-def _drawn_shades(grid: OccupancyGrid) -> tuple[np.ndarray, int]:
+def drawn_shades(grid: OccupancyGrid) -> tuple[np.ndarray, int]:
     """The map's shades as drawn and the edge (cells) of the square block each stands for:
     :func:`map_shades` itself (block 1) up to MAX_DRAWN_CELLS cells a side, else the
     darkest shade of each block, the last blocks padded with the edge cells' shades."""
@@ -81,7 +81,7 @@ def plot_trajectory(
     FigureCanvasAgg(figure)
     axes = figure.add_subplot()
     ox, oy, yaw = grid.origin
-    shades, block = _drawn_shades(grid)
+    shades, block = drawn_shades(grid)
     width, height = (
         shades.shape[1] * block * grid.resolution,
         shades.shape[0] * block * grid.resolution,

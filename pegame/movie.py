@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import math
 from collections.abc import Iterator
 from pathlib import Path
@@ -169,7 +170,8 @@ def write_video(game: RecordedGame, path: str | Path, size: int = 480, speed: fl
     every = max(1, math.ceil(speed / (dt * MAX_FPS) - 1e-9))  # ticks per frame
     fps = speed / (every * dt)
     path = Path(path)
-    first = renderer(game, size).frame(state(game, 0))
+    images = frames(game, size, every)
+    first = next(images)  # its size is the video's
     height, width = first.shape[:2]
     writer = imageio_ffmpeg.write_frames(
         str(path),
@@ -181,7 +183,7 @@ def write_video(game: RecordedGame, path: str | Path, size: int = 480, speed: fl
         ffmpeg_log_level="error",
     )
     writer.send(None)
-    for image in frames(game, size, every):
+    for image in itertools.chain([first], images):
         padded = np.pad(image, ((0, height % 2), (0, width % 2), (0, 0)), mode="edge")
         writer.send(np.ascontiguousarray(padded))
     writer.close()

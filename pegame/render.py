@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from PIL import Image, ImageDraw
 
-from pegame.figures import _drawn_shades
+from pegame.figures import drawn_shades
 from pegame.grid import OccupancyGrid
 
 PURSUER = (220, 40, 40)
@@ -67,7 +67,7 @@ class FrameRenderer:
         evader_radius: float,
         size: int = 480,
     ) -> None:
-        shades, block = _drawn_shades(grid)
+        shades, block = drawn_shades(grid)
         pixels = size / max(shades.shape)  # per drawn cell
         self.scale = pixels / (block * grid.resolution)  # px per m
         grey = Image.fromarray(np.uint8(np.round(255 * np.flipud(shades))))

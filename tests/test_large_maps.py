@@ -18,7 +18,7 @@ from pegame.bench_maps import format_rows, measure_parts, scaled_map, write_map
 from pegame.config import resolve_map_path
 from pegame.evaders import escape
 from pegame.evaders.escape import EscapeSearch
-from pegame.figures import MAX_DRAWN_CELLS, _drawn_shades, map_shades
+from pegame.figures import MAX_DRAWN_CELLS, drawn_shades, map_shades
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, load_map
 from pegame.grid.ros import _MapSpec, _occupancy
 from pegame.navigation import LARGE_GRID_CELLS, TIE_QUANTUM, Planner
@@ -193,13 +193,13 @@ def test_the_figure_draws_a_large_map_by_darkest_blocks():
     data[1234, :] = OCCUPIED  # a one-cell wall must not vanish from the figure
     data[:, 77] = UNKNOWN
     grid = OccupancyGrid(data, 0.05)
-    shades, block = _drawn_shades(grid)
+    shades, block = drawn_shades(grid)
     assert block == 3 and max(shades.shape) <= MAX_DRAWN_CELLS
     assert shades.shape == (math.ceil(2500 / 3), math.ceil(2100 / 3))
     full = map_shades(grid)
     assert shades[1234 // 3, 500] == full[1234, 1500] and shades[10, 77 // 3] == full[10, 77]
     paper = load_map(resolve_map_path("enclosed.yaml"))
-    drawn, one = _drawn_shades(paper)
+    drawn, one = drawn_shades(paper)
     assert one == 1 and np.array_equal(drawn, map_shades(paper))  # paper maps as before
 
 
