@@ -48,7 +48,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import NoReturn
 
 import numpy as np
 from omegaconf import DictConfig
@@ -95,29 +94,41 @@ PERCEPTION_OFF = {
 
 
 def check_playable(scenario: Scenario, settings: EnvSettings) -> None:
-    """ConfigError naming the first key whose value the batched game does not play."""
-
-    def refuse(key: str, value: object, allowed: str) -> NoReturn:
-        raise ConfigError(
-            f"Invalid value for '{key}' in a batched env: {value!r}. Allowed: {allowed} "
-            "(the batched kernels play only these; use the single env for the rest)."
-        )
-
+    """ConfigError naming every key whose value the batched game does not play, each with
+    the values it plays (one paragraph: a config such as ``+experiment=paper_conditions``
+    that sets several learns them all at once)."""
+    refused: list[tuple[str, object, str]] = []
     if scenario.classes["sim"] is not GridSimulator:
-        refuse("sim", scenario.names["sim"], "grid")
+        refused.append(("sim", scenario.names["sim"], "grid"))
     if scenario.classes["detector"] is not OracleDetector:
-        refuse("detector", scenario.names["detector"], "oracle")
-    for key, off in PERCEPTION_OFF.items():
-        value = getattr(scenario.configs["detector"], key)
-        if value != off:
-            refuse(f"detector.{key}", value, repr(off))
+        refused.append(("detector", scenario.names["detector"], "oracle"))
+    else:
+        for key, off in PERCEPTION_OFF.items():
+            value = getattr(scenario.configs["detector"], key)
+            if value != off:
+                refused.append((f"detector.{key}", value, repr(off)))
     for key, size in zip(("team.pursuers", "team.evaders"), scenario.team_size):
         if size != 1:
-            refuse(key, size, "1 (a team game is the PettingZoo env's, pegame.envs.parallel)")
+            refused.append(
+                (key, size, "1 (a team game is the PettingZoo env's, pegame.envs.parallel)")
+            )
     if scenario.settings.turn_order != "simultaneous":
-        refuse("game.turn_order", scenario.settings.turn_order, "simultaneous")
+        allowed = "'simultaneous' (a learner commands before it sees the other's move)"
+        refused.append(("game.turn_order", scenario.settings.turn_order, allowed))
     if settings.belief:
-        refuse("belief", settings.belief, "False (no estimator runs in the batched game)")
+        refused.append(("belief", settings.belief, "False (no estimator runs in the batched game)"))
+    if not refused:
+        return
+    tail = "the batched kernels play only these; use the single env for the rest"
+    if len(refused) == 1:
+        key, value, allowed = refused[0]
+        raise ConfigError(
+            f"Invalid value for '{key}' in a batched env: {value!r}. Allowed: {allowed} ({tail})."
+        )
+    listed = "; ".join(
+        f"'{key}': {value!r} (allowed: {allowed})" for key, value, allowed in refused
+    )
+    raise ConfigError(f"Invalid values in a batched env: {listed} ({tail}).")
 
 
 class BatchedGame:

@@ -70,6 +70,25 @@ def test_pursuit_plays_the_single_envs_games(opponent, model):
     assert ended == n  # one game each ended, and the next ones played on identically
 
 
+def test_acceleration_limits_and_substeps_are_played_not_ignored():
+    """The batched move ramps the velocities (a_max, alpha_max) and integrates the
+    physics substeps as the grid simulator does: the single env's games, bit for bit."""
+    overrides = [
+        *SHORT,
+        "evader.model=action",
+        "pursuer.a_max=0.5",
+        "pursuer.alpha_max=1.0",
+        "evader.a_max=0.8",
+        "game.physics_hz=30",
+    ]
+    batched = vector_env(2, overrides=overrides, opponent="random")
+    synced = SyncVectorEnv(
+        [lambda: PursuitEnv(overrides=overrides, opponent="random") for _ in range(2)]
+    )
+    ended = play_side_by_side(batched, synced, seed=4, steps=24, rng=np.random.default_rng(5))
+    assert ended == 2
+
+
 def test_evasion_against_random_actions_plays_the_single_envs_games():
     overrides = SHORT + ["pursuer.model=action"]
     batched = vector_env(2, overrides=overrides, opponent="random", role="evader")
@@ -213,7 +232,7 @@ def test_bad_actions_and_unsupported_configs_are_clear_errors():
 
 def test_a_team_is_refused_not_played_as_1v1():
     # vector_env(..., overrides=["team.pursuers=3", "team.evaders=2"]) played 1v1 silently
-    with pytest.raises(ConfigError, match="Invalid value for 'team.pursuers' in a batched env: 3"):
+    with pytest.raises(ConfigError, match="'team.pursuers': 3 .*; 'team.evaders': 2 "):
         vector_env(2, overrides=["env=hall", "team.pursuers=3", "team.evaders=2"])
     with pytest.raises(ConfigError, match="'team.evaders' in a batched env: 2"):
         vector_env(2, overrides=["env=hall", "team.evaders=2"], role="both")

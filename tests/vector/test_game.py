@@ -1,0 +1,67 @@
+"""The batched game refuses what its kernels do not play (pegame.vector.game.check_playable):
+each setting alone is a one-paragraph ConfigError naming the key, its value and what the
+batched game plays; a config that sets several is refused once, naming them all."""
+
+from __future__ import annotations
+
+import pytest
+
+from pegame.envs.vector import vector_env
+from pegame.errors import ConfigError
+
+BASE = ["env=hall", "evader.model=action"]
+
+
+@pytest.mark.parametrize(
+    ("override", "key", "value", "allowed"),
+    [
+        ("detector.rate=1.0", "detector.rate", "1.0", "None"),
+        ("detector.latency=0.1", "detector.latency", "0.1", "0.0"),
+        ("detector.miss_probability=0.1", "detector.miss_probability", "0.1", "0.0"),
+        ("detector.burst_miss_fraction=0.2", "detector.burst_miss_fraction", "0.2", "0.0"),
+        ("detector.miss_range_start=2.0", "detector.miss_range_start", "2.0", "None"),
+        ("detector.occlusion_miss=1.0", "detector.occlusion_miss", "1.0", "0.0"),
+        ("detector.range_noise=0.05", "detector.range_noise", "0.05", "0.0"),
+        ("detector.range_noise_growth=0.01", "detector.range_noise_growth", "0.01", "0.0"),
+        ("detector.bearing_noise=0.02", "detector.bearing_noise", "0.02", "0.0"),
+        ("detector.false_positive_rate=0.1", "detector.false_positive_rate", "0.1", "0.0"),
+        ("team.pursuers=2", "team.pursuers", "2", "1"),
+        ("team.evaders=3", "team.evaders", "3", "1"),
+        ("game.turn_order=evader_first", "game.turn_order", "'evader_first'", "'simultaneous'"),
+    ],
+)
+def test_each_setting_it_does_not_play_is_refused_by_name(override, key, value, allowed):
+    with pytest.raises(ConfigError) as error:
+        vector_env(2, overrides=[*BASE, override], opponent="random")
+    message = str(error.value)
+    assert message.startswith(f"Invalid value for '{key}' in a batched env: {value}. ")
+    assert f"Allowed: {allowed}" in message and "use the single env" in message
+    assert "\n" not in message
+
+
+def test_a_belief_in_the_observation_is_refused():
+    with pytest.raises(ConfigError, match=r"'belief' in a batched env: True\. Allowed: False"):
+        vector_env(2, overrides=BASE, opponent="random", belief=True)
+
+
+@pytest.mark.parametrize(("group", "name"), [("sim", "pybullet"), ("detector", "segmentation")])
+def test_another_simulator_or_detector_plugin_is_refused(group, name):
+    pytest.importorskip("pegame_pybullet")
+    with pytest.raises(
+        ConfigError, match=rf"Invalid value for '{group}' in a batched env: '{name}'"
+    ):
+        vector_env(2, overrides=[*BASE, f"{group}={name}"], opponent="random")
+
+
+def test_paper_conditions_are_refused_naming_every_setting_at_once():
+    with pytest.raises(ConfigError) as error:
+        vector_env(2, overrides=[*BASE, "+experiment=paper_conditions"], opponent="random")
+    message = str(error.value)
+    assert message.startswith("Invalid values in a batched env: 'detector.rate': 1.0 (allowed: ")
+    for part in (
+        "'detector.latency': 0.1",
+        "'detector.occlusion_miss': 1.0",
+        "'game.turn_order': 'evader_first'",
+    ):
+        assert part in message
+    assert "\n" not in message
