@@ -4,6 +4,7 @@ first use, so that ``python -m pegame.bench`` formats its report without them.""
 
 from __future__ import annotations
 
+import math
 import os
 import statistics
 import time
@@ -90,6 +91,14 @@ def _vector_steps_per_second(
     return actions.shape[0] * env.num_envs / (time.perf_counter() - start)
 
 
+def _decision_periods(env: PursuitVectorEnv | EvasionVectorEnv) -> int:
+    """The fewest env steps of ``env`` that hold whole decision periods of its opponent:
+    lcm(decide_every, ticks per step) control ticks."""
+    game = env.game
+    ticks = math.lcm(game.rules.decide_every, game.ticks_per_action)
+    return ticks // game.ticks_per_action
+
+
 def bench_vector_env(
     seconds: float = 20.0,
     num_envs: int = 4096,
@@ -107,9 +116,13 @@ def bench_vector_env(
     batched pursuer env of ``num_envs`` games against the random evader with
     ``model=action`` on one numba thread (the per-core figure, as NUMBA_NUM_THREADS=1)
     and on all of numba's threads, and the batched env of ``smart_envs`` games against
-    the smart evader. Resets are not timed (a reset spawns each game in Python: its cost
-    per game is ``vector_reset_ms_per_game``). Figures are medians over the rounds;
-    ``vector_speedup_per_core`` is the median of the rounds' ratios to the single env.
+    the smart evader over whole decision periods (the env steps holding a whole number of
+    the evader's decision intervals: 10 at the defaults, the smart evader deciding every
+    10th tick; a shorter round mostly holds no decision and overstates the rate; a game
+    that would end inside a round is reset first, untimed). Resets are not timed (a reset
+    spawns each game in Python: its cost per game is ``vector_reset_ms_per_game``).
+    Figures are medians over the rounds; ``vector_speedup_per_core`` is the median of the
+    rounds' ratios to the single env.
     ``settings``: env options (:class:`pegame.envs.settings.EnvSettings`) for both.
     Memory per game: the resident memory the batched env added (its kernels already
     loaded), divided by the games; and the bytes of its arrays per game (state, opponent
@@ -143,6 +156,8 @@ def bench_vector_env(
     smart = vector_env(smart_envs, overrides=overrides, opponent="smart", **settings)
     smart.reset(seed=seed)
     smart.step(np.zeros((smart_envs, 2), np.float32))
+    smart_round = _decision_periods(smart)
+    smart_played, smart_games = 1, 1
     per_round: dict[str, list[float]] = {"single": [], "core": [], "all": [], "smart": []}
     batch = 4
     played = 1
@@ -157,8 +172,12 @@ def bench_vector_env(
         actions = rng.uniform(-1.0, 1.0, (batch, num_envs, 2)).astype(np.float32)
         per_round["core"].append(_vector_steps_per_second(env, actions, 1))
         per_round["all"].append(_vector_steps_per_second(env, actions, threads))
-        actions = rng.uniform(-1.0, 1.0, (batch, smart_envs, 2)).astype(np.float32)
+        if smart_played + smart_round >= smart.game.steps:
+            smart.reset(seed=seed + smart_games * smart_envs)
+            smart_played, smart_games = 0, smart_games + 1
+        actions = rng.uniform(-1.0, 1.0, (smart_round, smart_envs, 2)).astype(np.float32)
         per_round["smart"].append(_vector_steps_per_second(smart, actions, 1))
+        smart_played += smart_round
         played += 3 * batch
     numba.set_num_threads(threads)
     single.close()
