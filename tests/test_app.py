@@ -86,6 +86,7 @@ def test_the_console_names_each_games_cell_and_a_jobs_mean_with_its_ci(tmp_path)
         "pegame: cell 2 of 2",
     ]
     assert all(": exit 0, " in line for line in progress)  # one line per cell, as it ends
+    assert [line.split("; ")[-1] for line in progress] == ["games 2 of 4", "games 4 of 4"]
 
 
 @pytest.mark.slow

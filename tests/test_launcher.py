@@ -137,3 +137,52 @@ def test_an_interrupt_stops_the_sweep_and_its_workers(tmp_path, how):
     assert proc.wait(timeout=300) == 130
     assert wait_exit(worker), "a worker outlived the sweep"
     assert len(seeds(sweep / "0")) < 400
+
+
+class FakeTerminal:
+    """A stderr that is a terminal: what tqdm draws lands in ``text``."""
+
+    def __init__(self) -> None:
+        self.text = ""
+
+    def isatty(self) -> bool:
+        return True
+
+    def write(self, text: str) -> int:
+        self.text += text
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+
+def test_the_progress_bar_counts_games_as_they_are_stored(monkeypatch):
+    from hydra.core.utils import JobReturn, JobStatus
+    from hydra_plugins.pegame_launcher._pool import Progress
+
+    terminal = FakeTerminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    progress = Progress([3, 2])
+    assert progress.bar is not None and progress.bar.total == 5 and progress.poll
+    progress.running({0: 1, 1: 5})  # a job's count is capped at its trials
+    assert progress.bar.n == 3
+    progress.running({0: 0})  # never back (a stale read)
+    assert progress.bar.n == 3
+    finished = JobReturn(status=JobStatus.COMPLETED, _return_value=0)
+    progress.done(0, 0, ["env=hall"], finished)  # a resumed job's stored games count at its end
+    assert progress.bar.n == 5
+    progress.close()
+    assert "5/5" in terminal.text and "game" in terminal.text
+
+
+def test_without_a_terminal_each_cell_prints_a_line_with_the_games(monkeypatch, capsys):
+    from hydra.core.utils import JobReturn, JobStatus
+    from hydra_plugins.pegame_launcher._pool import Progress
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False, raising=False)
+    progress = Progress([4, 4, 2])
+    assert progress.bar is None and progress.poll is None  # no polling without a bar
+    progress.done(1, 7, ["env=brick"], JobReturn(status=JobStatus.COMPLETED, _return_value=1))
+    line = capsys.readouterr().out.strip()
+    assert line.startswith("pegame: cell 1 of 3 done (#7 env=brick): exit 1, ")
+    assert line.endswith("; games 4 of 10")

@@ -8,9 +8,11 @@ jobs running in the other workers are not touched, so the sweep goes on and ends
 its report and exit status 1. On an interrupt (Ctrl-C, SIGTERM: a KeyboardInterrupt in
 the sweep's process) or an error every worker is killed and reaped before it goes on.
 
-The sweep's progress over its cells is shown as each job ends: a progress bar on stderr
-where it is a terminal, else one line per cell on stdout (``pegame: cell 3 of 36 done
-(#2 env=hall ...): exit 0, 41 s``)."""
+The sweep's progress is counted in games (each job plays its cell's ``game.trials``): a
+progress bar on stderr where it is a terminal, moved as each game's entry reaches its
+job's results.jsonl (polled every :data:`POLL_S`); else one line per cell on stdout as
+each job ends (``pegame: cell 3 of 36 done (#2 env=hall ...): exit 0, 41 s; games 120
+of 1440``). A job's games stored by an earlier run (``resume=true``) count when it ends."""
 
 from __future__ import annotations
 
@@ -38,6 +40,9 @@ from pegame import sweep
 
 log = logging.getLogger(__name__)
 
+#: seconds between looks at the running jobs' results.jsonl for the progress bar
+POLL_S = 1.0
+
 
 @dataclass
 class Worker:
@@ -48,6 +53,10 @@ class Worker:
     connection: Connection
     job: int | None = None
     before: int = 0
+
+    def played(self, sweep_config: DictConfig) -> int:
+        """Entries the running job's results.jsonl gained since it was sent."""
+        return entries(sweep_config) - self.before
 
 
 class Pool:
@@ -79,7 +88,8 @@ class Pool:
         for idx, overrides in enumerate(jobs):
             log.info(f"\t#{idx} : {' '.join(filter_overrides(overrides))}")
         returns: dict[int, JobReturn] = {}
-        self.progress = Progress(len(jobs))
+        self.configs = [self.sweep_config(first + i, job) for i, job in enumerate(jobs)]
+        self.progress = Progress([trials(config) for config in self.configs])
         try:
             self.run(jobs, first, returns)
         finally:
@@ -98,7 +108,15 @@ class Pool:
                     self.send(worker, pending.popleft(), first, jobs)
                 elif worker.job is None:
                     self.retire(worker)  # no job left for it
-            ready = wait([w.connection for w in self.workers])
+            ready = wait([w.connection for w in self.workers], self.progress.poll)
+            if not ready:
+                self.progress.running(
+                    {
+                        w.job: w.played(self.configs[w.job])
+                        for w in self.workers
+                        if w.job is not None
+                    }
+                )
             for worker in [w for w in self.workers if w.connection in ready]:
                 job = worker.job
                 assert job is not None
@@ -108,11 +126,11 @@ class Pool:
                 except EOFError:
                     returns[job] = self.dead(worker, first, jobs)
                     self.retire(worker)
-                self.progress.done(first + job, jobs[job], returns[job])
+                self.progress.done(job, first + job, jobs[job], returns[job])
 
     def send(self, worker: Worker, job: int, first: int, jobs: list[list[str]]) -> None:
         """Give ``worker`` the job of index ``job``."""
-        worker.job, worker.before = job, entries(self.sweep_config(first + job, jobs[job]))
+        worker.job, worker.before = job, entries(self.configs[job])
         task = (first + job, jobs[job], self.context, self.config, self.task, Singleton.get_state())
         worker.connection.send_bytes(cloudpickle.dumps(task))
 
@@ -121,7 +139,7 @@ class Pool:
         assert worker.job is not None
         worker.process.join()
         why, overrides = cause(worker.process.exitcode), jobs[worker.job]
-        sweep_config = self.sweep_config(first + worker.job, overrides)
+        sweep_config = self.configs[worker.job]
         log.error(f"job #{first + worker.job} ({' '.join(overrides)}): {why}")
         record_dead_job(sweep_config, overrides, worker.before, why)
         return JobReturn(
@@ -159,33 +177,60 @@ class Pool:
 
 
 class Progress:
-    """The sweep's progress over its ``total`` cells (module docstring)."""
+    """The sweep's progress over its games, ``games[job]`` per job (module docstring)."""
 
-    def __init__(self, total: int) -> None:
-        self.total, self.count, self.started = total, 0, time.perf_counter()
+    def __init__(self, games: list[int]) -> None:
+        self.games, self.total = games, sum(games)
+        self.counted = [0] * len(games)  # games of each job counted so far
+        self.cells, self.started = 0, time.perf_counter()
         self.bar = None
-        if sys.stderr.isatty() and total > 1:
+        self.poll: float | None = None  # no polling without a bar
+        if sys.stderr.isatty() and len(games) > 1:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=total, desc="cells", unit="cell")
+            self.bar = tqdm(total=self.total, desc="games", unit="game")
+            self.poll = POLL_S
 
-    def done(self, num: int, overrides: list[str], returned: JobReturn) -> None:
-        """Job ``num`` (its ``overrides``) ended with ``returned``."""
-        self.count += 1
+    def _count(self, job: int, games: int) -> None:
+        games = max(self.counted[job], min(games, self.games[job]))
         if self.bar is not None:
-            self.bar.update(1)
+            self.bar.update(games - self.counted[job])
+        self.counted[job] = games
+
+    def running(self, played: dict[int, int]) -> None:
+        """The running jobs have played ``played[job]`` games so far."""
+        for job, games in played.items():
+            self._count(job, games)
+
+    def done(self, job: int, num: int, overrides: list[str], returned: JobReturn) -> None:
+        """Job ``job`` (numbered ``num``, its ``overrides``) ended with ``returned``: all
+        its games count."""
+        self.cells += 1
+        self._count(job, self.games[job])
+        if self.bar is not None:
             return
         status = returned.return_value if returned.status == JobStatus.COMPLETED else "error"
         elapsed = time.perf_counter() - self.started
         print(
-            f"pegame: cell {self.count} of {self.total} done (#{num} "
-            f"{' '.join(filter_overrides(overrides))}): exit {status}, {elapsed:.0f} s",
+            f"pegame: cell {self.cells} of {len(self.games)} done (#{num} "
+            f"{' '.join(filter_overrides(overrides))}): exit {status}, {elapsed:.0f} s; "
+            f"games {sum(self.counted)} of {self.total}",
             flush=True,
         )
 
     def close(self) -> None:
         if self.bar is not None:
             self.bar.close()
+
+
+def trials(sweep_config: DictConfig) -> int:
+    """The games a job plays (its ``game.trials``); 1 where that is no positive integer,
+    which the job itself then refuses with its error."""
+    try:
+        value = int(sweep_config.game.trials)
+    except Exception:  # a missing or malformed value: the job reports it
+        return 1
+    return max(value, 1)
 
 
 def spawn() -> Worker:
