@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Generic, NamedTuple, TypeVar
 import numpy as np
 
 from pegame.errors import require
+from pegame.losses import Loss
 from pegame.types import (
     EMPTY_BELIEF,
     STOP,
@@ -171,7 +172,9 @@ class Tick:
     frame; detection or None; belief; region: the pursuer's visibility region (None when not computed);
     in_view: ground-truth visibility of the evader; commands: (pursuer, evader) velocities
     applied after this tick (with ``game.turn_order=evader_first`` the evader's was applied
-    just before it, see :mod:`pegame.loop`); plans: the latest (pursuer, evader) plans.
+    just before it, see :mod:`pegame.loop`); plans: the latest (pursuer, evader) plans;
+    team: every member's part in a team game; losses: the losses of track begun at this
+    tick, every pair's, each with its cause (:mod:`pegame.losses`).
     """
 
     step: int
@@ -186,6 +189,7 @@ class Tick:
     commands: tuple[Velocity, Velocity]
     plans: tuple[Plan, Plan]
     team: TeamTick | None = None
+    losses: tuple[Loss, ...] = ()
 
 
 @value_type(eq=False)

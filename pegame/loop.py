@@ -8,7 +8,9 @@ belief from the detection and the region; ground truth ``in_view`` is whether an
 the evader's body is in the pursuer's view. At every decision tick (every
 ``decide_every`` ticks, the paper's 1 Hz nodes) the evader decides first, then the
 pursuer; then both strategies give their velocity commands, the tick is measured and
-handed to the recorder, and the simulator integrates the commands for one period.
+handed to the recorder, and the simulator integrates the commands for one period. The
+measures include every loss of track and its cause (:mod:`pegame.losses`), which the tick
+hands to the recorder (``Tick.losses``).
 
 Timing (``game.physics_hz``, ``game.turn_order``; every default keeps the order above):
 
@@ -73,6 +75,7 @@ from pegame.api import (
 )
 from pegame.config import TURN_ORDERS
 from pegame.errors import ConfigError
+from pegame.losses import LossCauses
 from pegame.metrics import TeamMetrics, TrackingMetrics
 from pegame.types import (
     EMPTY_BELIEF,
@@ -202,12 +205,16 @@ class TickLoop:
         self.substeps = substeps
         self.turn_order = turn_order
         # the game's measures; a 1v1 game's ticks add to them as ``tracking``, a team's
-        # as ``team_metrics`` (each defined only in its kind of game)
+        # as ``team_metrics`` (each defined only in its kind of game); every pair's
+        # losses of track and their causes (``losses``) are part of them
+        self.losses = LossCauses(context, self.n_pursuers, self.n_evaders)
         self.metrics: TrackingMetrics | TeamMetrics
         if self.solo:
-            self.tracking = self.metrics = TrackingMetrics(context.control_dt)
+            self.tracking = self.metrics = TrackingMetrics(context.control_dt, self.losses)
         else:
-            self.team_metrics = self.metrics = TeamMetrics(context, self.n_pursuers, self.n_evaders)
+            self.team_metrics = self.metrics = TeamMetrics(
+                context, self.n_pursuers, self.n_evaders, self.losses
+            )
         self.step = 0
         self.time = 0.0  # s, simulation time of the current tick: step * control_dt
         self.evader_first = turn_order == "evader_first"
@@ -418,13 +425,9 @@ class TickLoop:
         p_cmds, e_cmds = commanded["pursuer"], commanded["evader"]
         in_view = self.in_views[0][0] if self.solo else self.in_view
         if self.solo:
-            self.tracking.add(
-                self.pursuers[0],
-                self.evaders[0],
-                self.detections[0][0] is not None,
-                in_view,
-                self.beliefs[0],
-            )
+            detected = self.detections[0][0] is not None
+            self.tracking.add(self.pursuers[0], self.evaders[0], detected, in_view, self.beliefs[0])
+            losses = self.losses.add_one(self.pursuers[0], self.evaders[0], detected, p_cmds[0])
         else:
             self.team_metrics.add(
                 self.pursuers,
@@ -434,6 +437,7 @@ class TickLoop:
                 self.beliefs,
                 self.union if deciding else None,
             )
+            losses = self.losses.add(self.pursuers, self.evaders, self.detections, p_cmds)
         tick = Tick(
             self.step,
             self.time,
@@ -461,6 +465,7 @@ class TickLoop:
                 tuple(self.pursuer_plans),
                 tuple(self.evader_plans),
             ),
+            losses,
         )
         self.recorder.log(tick)
         if self.evader_first:
@@ -499,8 +504,9 @@ class TickLoop:
             p_cmd = pursuer_strategy.control(p_obs)
         if e_obs is not None:
             e_cmd = evader_strategy.control(e_obs)
-        in_view = self.in_views[0][0]
-        self.tracking.add(pursuer, evader, detection is not None, in_view, belief)
+        in_view, detected = self.in_views[0][0], detection is not None
+        self.tracking.add(pursuer, evader, detected, in_view, belief)
+        losses = self.losses.add_one(pursuer, evader, detected, p_cmd)
         tick = Tick(
             self.step,
             time,
@@ -514,6 +520,7 @@ class TickLoop:
             (p_cmd, e_cmd),
             (self.pursuer_plans[0], self.evader_plans[0]),
             None,
+            losses,
         )
         self.recorder.log(tick)
         dt = self.context.control_dt / self.substeps

@@ -17,13 +17,17 @@ tracker, the pursuer that has detected it since the others lost it, stops detect
 while another pursuer does, or the tracker loses it in the very tick another takes it),
 and the team's *coverage*, the mean fraction of the map's free cells inside the union of
 the pursuers' regions, sampled at decision ticks.
+
+Each loss of track of every (pursuer, evader) pair gets a cause from the ground truth at
+its tick (:mod:`pegame.losses`); the summary's ``loss_causes`` gives their counts and the
+time lost per cause.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -31,6 +35,7 @@ from pegame.types import Belief, Detection, Pose, Region
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from pegame.api import Context
+    from pegame.losses import LossCauses
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
@@ -53,11 +58,13 @@ def _path_length(xy: np.ndarray) -> float:
 class TrackingMetrics:
     """Accumulates one game tick by tick; ``summary()`` gives the result's measures.
 
-    dt: control period (s).
+    dt: control period (s); losses: the game's loss causes (:mod:`pegame.losses`, fed
+    by the tick loop), summarised as ``loss_causes`` when given.
     """
 
-    def __init__(self, dt: float) -> None:
+    def __init__(self, dt: float, losses: LossCauses | None = None) -> None:
         self.dt = dt
+        self.losses = losses
         self.pursuer: list[tuple[float, float]] = []
         self.evader: list[tuple[float, float]] = []
         self.detected: list[bool] = []
@@ -89,8 +96,9 @@ class TrackingMetrics:
         """Fraction of ticks so far with the evader detected."""
         return self.detected_ticks / len(self.detected) if self.detected else 0.0
 
-    def summary(self) -> dict[str, float | int | None]:
-        """The game's measures: rates in [0, 1], times in s, distances in m."""
+    def summary(self) -> dict[str, Any]:
+        """The game's measures: rates in [0, 1], times in s, distances in m; with
+        ``losses``, ``loss_causes`` (:meth:`pegame.losses.LossCauses.summary`)."""
         detected = np.asarray(self.detected, dtype=bool)
         losses = _runs(~detected)
         reacquired = [(stop - start) * self.dt for start, stop in losses if stop < detected.size]
@@ -98,7 +106,7 @@ class TrackingMetrics:
         pursuer, evader = np.asarray(self.pursuer), np.asarray(self.evader)
         errors = np.asarray(self.estimate_error)
         errors = errors[np.isfinite(errors)]
-        return {
+        summary: dict[str, Any] = {
             "tracking_rate": _rounded(detected.mean()),
             "visible_rate": _rounded(np.mean(self.in_view)),
             "time_to_first_loss": _rounded(first_loss),
@@ -114,17 +122,24 @@ class TrackingMetrics:
             "n_eff_min": _rounded(min(self.n_eff)) if self.n_eff else None,
             "resamplings": self.resamplings,
         }
+        if self.losses is not None:
+            summary["loss_causes"] = self.losses.summary()
+        return summary
 
 
 class TeamMetrics:
     """Accumulates a team game (module docstring) tick by tick; ``summary()`` gives the
     result's measures, the 1v1 keys (means over the evaders) and the team's.
 
-    context: the game's; pursuers, evaders: the team sizes N and M.
+    context: the game's; pursuers, evaders: the team sizes N and M; losses: the game's
+    loss causes, every pair's (:mod:`pegame.losses`), summarised as ``loss_causes``.
     """
 
-    def __init__(self, context: Context, pursuers: int, evaders: int) -> None:
+    def __init__(
+        self, context: Context, pursuers: int, evaders: int, losses: LossCauses | None = None
+    ) -> None:
         self.dt = context.control_dt
+        self.losses = losses
         self.free = ~context.grid.blocked
         self.free_cells = max(1, int(self.free.sum()))
         self.per_evader = [TrackingMetrics(self.dt) for _ in range(evaders)]
@@ -182,10 +197,10 @@ class TeamMetrics:
         """Mean over the evaders of their fractions of ticks so far detected by some pursuer."""
         return float(np.mean([m.tracking_rate for m in self.per_evader]))
 
-    def summary(self) -> dict[str, float | int | list | None]:
+    def summary(self) -> dict[str, Any]:
         """The 1v1 measures as means over the evaders, then the team's (module docstring)."""
         summaries = [m.summary() for m in self.per_evader]
-        result: dict[str, float | int | list | None] = {}
+        result: dict[str, Any] = {}
         for key in summaries[0]:
             values = [v for v in (s[key] for s in summaries) if v is not None]
             result[key] = _rounded(np.mean(values)) if values else None
@@ -204,4 +219,6 @@ class TeamMetrics:
                 "coverage": _rounded(np.mean(self.coverage)) if self.coverage else None,
             }
         )
+        if self.losses is not None:
+            result["loss_causes"] = self.losses.summary()
         return result
