@@ -20,6 +20,7 @@ from pegame.api import Context, Tick
 from pegame.figures import plot_trajectory
 from pegame.game import Game
 from pegame.grid import OccupancyGrid
+from pegame.losses import OCCLUDED, Loss
 from pegame.recorders.rerun import RerunRecorder, recording_id
 from pegame.replay import find_recordings
 from pegame.types import (
@@ -74,6 +75,21 @@ def read_steps(path: Path) -> tuple[dict[str, list[int]], set[str], list]:
         else:
             steps[chunk.entity_path].extend(chunk.to_record_batch().column("step").to_pylist())
     return steps, static, reader.blueprints()
+
+
+def texts(path: Path, entity: str) -> list[tuple[str, str]]:
+    """(level, text) of every line of the TextLog ``entity`` of an .rrd file."""
+    from rerun.chunk import RrdReader
+
+    lines = []
+    for chunk in RrdReader(path).stream().to_chunks():
+        if chunk.entity_path == entity:
+            batch = chunk.to_record_batch()
+            for levels, words in zip(
+                batch.column("TextLog:level").to_pylist(), batch.column("TextLog:text").to_pylist()
+            ):
+                lines += zip(levels, words)
+    return lines
 
 
 @pytest.fixture(scope="module")
@@ -262,14 +278,10 @@ def test_a_failed_game_leaves_a_failed_recording_readable_up_to_its_failure(fail
     for entity in PER_TICK:
         assert steps[entity] == list(range(20)), entity  # flushed at the failure
     assert "/__properties/failure" in static and "/__properties/result" not in static
-    events, failure = [], {}
+    failure = {}
     for chunk in RrdReader(path).stream().to_chunks():
         batch = chunk.to_record_batch()
-        if chunk.entity_path == "/events":
-            events += zip(
-                batch.column("TextLog:level").to_pylist(), batch.column("TextLog:text").to_pylist()
-            )
-        elif chunk.entity_path == "/__properties/failure":
+        if chunk.entity_path == "/__properties/failure":
             failure.update(
                 {
                     name: batch.column(name).to_pylist()[0][0]
@@ -277,7 +289,8 @@ def test_a_failed_game_leaves_a_failed_recording_readable_up_to_its_failure(fail
                     if name != "rerun.controls.RowId"
                 }
             )
-    assert (["ERROR"], ["game failed after step 19: RuntimeError: pursuer broke"]) in events
+    events = texts(path, "/events")
+    assert ("ERROR", "game failed after step 19: RuntimeError: pursuer broke") in events
     assert failure == {"error": "RuntimeError", "message": "pursuer broke", "step": 19}
 
 
@@ -320,7 +333,8 @@ def small_context() -> Context:
 
 
 def synthetic_ticks(context: Context, count: int) -> list[Tick]:
-    """Ticks with particles, weights, N_eff, candidates, a mode and a lost detection."""
+    """Ticks with particles, weights, N_eff, candidates, a mode and a lost detection (an
+    occluded evader at tick 4)."""
     rng = np.random.default_rng(1)
     ticks = []
     plans = {}
@@ -363,6 +377,8 @@ def synthetic_ticks(context: Context, count: int) -> list[Tick]:
                 detection is not None,
                 (Velocity(), Velocity()),
                 plans[decision],
+                None,
+                (Loss(0, 0, step, OCCLUDED),) if step == 4 else (),
             )
         )
     return ticks
@@ -390,6 +406,13 @@ def test_recorder_logs_particles_candidates_n_eff_and_events(tmp_path):
     # start, lost at 4, reacquired at 8, pursuer modes at 0, 5, 10, 15, 20, game over at 22
     assert sorted(steps["/events"]) == [0, 0, 4, 5, 8, 10, 15, 20, 22]
     assert "/__properties/result" in static
+    assert steps["/losses"] == [4]
+    assert texts(tmp_path / "game_7.rrd", "/losses") == [
+        ("WARN", "pursuer 0 lost evader 0: occluded")
+    ]
+    assert ("WARN", "evader lost after 0.4 s tracked: occluded") in texts(
+        tmp_path / "game_7.rrd", "/events"
+    )
 
 
 def test_spawn_sends_live_to_a_viewer_as_well_as_to_the_file(monkeypatch, tmp_path):

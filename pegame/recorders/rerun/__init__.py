@@ -49,6 +49,9 @@ plots/distance/estimate_error  Scalars: |belief.mean - true evader| (m), when es
 plots/n_eff                Scalars: the estimator's N_eff, when it gives one
 events                     TextLog: loss, reacquisition, pursuer mode, game over, or
                            (ERROR) the failure of the game
+losses                     TextLog (WARN): each loss of track, its pair and its cause
+                           (:mod:`pegame.losses`); the events' loss line names the
+                           cause too                                    each loss
 config                     TextDocument: the run config as YAML (static)
 ========================== =========================================================
 
@@ -56,7 +59,7 @@ A tick with nothing to show (no detection, no estimate) gets an empty row, which
 the entity in the viewer. Recording properties: the recording name, ``config`` and, at
 the end, ``result`` or ``failure`` (see :mod:`.properties`). The default blueprint shows
 the map view large and, beside it, the camera (when the simulator renders images), the
-plots, the events and the config.
+plots, the events, the losses and the config.
 """
 
 from pegame.recorders.rerun.properties import recording_id, recording_name

@@ -2,7 +2,8 @@
 
 The map view, large, looks straight down on the map as RViz does; beside it the camera
 (when the simulator renders images), the plots (tracking, distances, N_eff) and, in
-tabs, the events and the config. Entity paths are those of :mod:`.scene`.
+tabs, the events, the losses of track and the config. Entity paths are those of
+:mod:`.scene`.
 """
 
 from __future__ import annotations
@@ -62,6 +63,7 @@ def blueprint(grid: OccupancyGrid, camera: Camera, has_image: bool) -> rrb.Bluep
         rrb.TimeSeriesView(origin="plots/n_eff", name="N_eff"),
         rrb.Tabs(
             rrb.TextLogView(origin="events", name="Events"),
+            rrb.TextLogView(origin="losses", name="Losses"),
             rrb.TextDocumentView(origin="config", name="Config"),
         ),
     ]

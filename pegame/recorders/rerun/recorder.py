@@ -53,6 +53,7 @@ from pegame.recorders.rerun.scene import (
     Z_PARTICLES,
     Buffers,
     buffer_event,
+    buffer_losses,
     buffer_plan,
     log_agents,
     log_image,
@@ -274,6 +275,7 @@ class RerunRecorder(Recorder):
             self._particles.add(tick.step, tick.time, tick.belief.particles, tick.belief.weights)
         self._log_plans(tick)
         self._log_detection_events(tick)
+        buffer_losses(self._buffers, tick)
         buffer_team(self._buffers, tick, self.context, self.config.max_particles)
         every = self.config.image_every
         if tick.frame.rgb is not None and every and tick.step % every == 0:
@@ -296,7 +298,7 @@ class RerunRecorder(Recorder):
                 buffer_event(self._buffers, tick.step, tick.time, f"{name} mode: {mode}")
 
     def _log_detection_events(self, tick: Tick) -> None:
-        """An event when the detector loses or reacquires the evader."""
+        """An event when the detector loses (with the loss's cause) or reacquires the evader."""
         detected = tick.detection is not None
         if detected == self._detected:
             return
@@ -313,6 +315,8 @@ class RerunRecorder(Recorder):
             )
         else:
             text, level = f"evader lost after {tick.time - self._changed_at:.1f} s tracked", "WARN"
+            causes = [loss.cause for loss in tick.losses if (loss.pursuer, loss.evader) == (0, 0)]
+            text += "".join(f": {cause}" for cause in causes)
         self._detected, self._changed_at = detected, tick.time
         buffer_event(self._buffers, tick.step, tick.time, text, level)
 

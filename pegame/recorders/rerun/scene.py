@@ -333,6 +333,14 @@ def buffer_event(buffers: Buffers, step: int, time: float, text: str, level: str
     buffers.add("events", rr.TextLog, step, time, text=[text], level=[level])
 
 
+def buffer_losses(buffers: Buffers, tick: Tick) -> None:
+    """One line of the losses log per loss of track begun at ``tick``, naming its pair and
+    its cause (:mod:`pegame.losses`)."""
+    for loss in tick.losses:
+        text = f"pursuer {loss.pursuer} lost evader {loss.evader}: {loss.cause}"
+        buffers.add("losses", rr.TextLog, tick.step, tick.time, text=[text], level=["WARN"])
+
+
 def log_image(rec: rr.RecordingStream, tick: Tick, camera: Camera, jpeg_quality: int) -> None:
     """The tick's camera image as JPEG, logged directly: it is rare and large."""
     rec.set_time(STEP, sequence=tick.step)
