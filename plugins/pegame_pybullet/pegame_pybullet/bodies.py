@@ -1,4 +1,4 @@
-"""The two agents as PyBullet bodies built from primitive shapes.
+"""The pursuer as a PyBullet body built from primitive shapes, and the agents' colours.
 
 Each body's frame has its origin on the floor under the agent's centre, x forward and z up,
 so a planar pose (x, y, theta) places it directly. Collision is an upright cylinder (the
@@ -6,9 +6,9 @@ agent's disc); the visual model is a compound of primitives with per-part colour
 
 - Pursuer: a TurtleBot 2 look-alike (Kobuki base, three plates on posts, a Kinect-like
   sensor bar on top, behind the camera's optical centre so it never enters the image).
-- Evader: a person 1.70 m tall (the oracle detector's default ``evader_height``): legs
-  and arms as capsules, a box torso, a sphere head; red shirt, blue trousers. The scenery
-  is neutral grey, so the clothing is the only saturated colour in view (what
+- Evader: the articulated person of :mod:`pegame_pybullet.person` (its colours are here);
+  1.70 m tall (the oracle detector's default ``evader_height``), red shirt, blue trousers.
+  The scenery is neutral grey, so the clothing is the only saturated colour in view (what
   ``detector=vision``'s colour model relies on).
 """
 
@@ -53,20 +53,6 @@ def turtlebot(radius: float, camera_height: float) -> list[Part]:
         length = plate_top - 0.1
         parts.append(Part(cyl, (0.006, length), (sx * post, sy * post, 0.1 + 0.5 * length), grey))
     parts.append(Part(box, (0.03, 0.14, 0.02), (-0.035, 0.0, camera_height), black))
-    return parts
-
-
-def person() -> list[Part]:
-    """A person 1.70 m tall facing +x."""
-    cap, box = pybullet.GEOM_CAPSULE, pybullet.GEOM_BOX
-    sph, cyl = pybullet.GEOM_SPHERE, pybullet.GEOM_CYLINDER
-    parts = []
-    for side in (1, -1):
-        parts.append(Part(cap, (0.075, 0.65), (0.0, side * 0.095, 0.45), TROUSERS_RGB))  # leg
-        parts.append(Part(cap, (0.04, 0.5), (0.0, side * 0.215, 1.12), SHIRT_RGB))  # arm
-    parts.append(Part(box, (0.11, 0.17, 0.30), (0.0, 0.0, 1.15), SHIRT_RGB))  # torso
-    parts.append(Part(cyl, (0.05, 0.08), (0.0, 0.0, 1.48), SKIN_RGB))  # neck
-    parts.append(Part(sph, (0.11,), (0.0, 0.0, 1.59), SKIN_RGB))  # head
     return parts
 
 

@@ -45,14 +45,18 @@ from pegame.api import Context, Simulator
 from pegame.errors import ConfigError, require
 from pegame.sims.grid import saturate, unicycle
 from pegame.types import Body, Pose, SensorFrame, Velocity
-from pegame_pybullet.bodies import EVADER_HEIGHT, PURSUER_HEIGHT, create_body, person, turtlebot
+from pegame_pybullet.bodies import EVADER_HEIGHT, PURSUER_HEIGHT, create_body, turtlebot
 from pegame_pybullet.camera import DepthCamera
 from pegame_pybullet.client import Client
+from pegame_pybullet.person import Walker, create_person
 from pegame_pybullet.world import build_world
 
 PENETRATION_TOLERANCE = 1e-4  # m; a touching pose (distance ~0 after bisection) is free
 BISECTIONS = 8  # a blocked sub-step is resolved to 1/256 of its length
 HIDDEN_Z = -1000.0  # m; where a body goes while a camera must not see it
+#: rad, the camera's downward pitch in the paper's simulations (Sec. V: "a RGB-D sensor
+#: tilted at an angle of pi/8 downward")
+PAPER_TILT = math.pi / 8
 
 
 def _orientation(theta: float) -> list[float]:
@@ -70,9 +74,11 @@ class _Mover:
         limits: Body,
         collision_radius: float,
         height: float,
+        walker: Walker | None = None,
     ) -> None:
         self.client, self.body, self.walls, self.limits = client, body, frozenset(walls), limits
         self.radius, self.height = collision_radius, height
+        self.walker = walker  # the evader's gait, advanced by the distance each move covers
         self.pose = Pose(0.0, 0.0, 0.0)
 
     def _place(self, x: float, y: float, theta: float) -> None:
@@ -106,6 +112,8 @@ class _Mover:
     def reset(self, pose: Pose) -> bool:
         """Place the body at ``pose``; False when it is inside a wall there."""
         self.pose = pose
+        if self.walker is not None:
+            self.walker.reset()
         return not self.collides(pose.x, pose.y, pose.theta)
 
     def move(self, cmd: Velocity, dt: float) -> None:
@@ -129,6 +137,9 @@ class _Mover:
             free = fraction
         self.pose = Pose(start.x + free * dx, start.y + free * dy, target.theta)
         self._place(self.pose.x, self.pose.y, self.pose.theta)
+        if self.walker is not None:  # the distance walked along the new heading (m)
+            c, s = math.cos(target.theta), math.sin(target.theta)
+            self.walker.walk(free * (c * dx + s * dy))
 
 
 class PybulletSimulator(Simulator):
@@ -138,11 +149,12 @@ class PybulletSimulator(Simulator):
 
     @dataclass
     class Config:
-        width: int = 160  # px, rendered image width
-        height: int = 120  # px, rendered image height
+        # px, rendered image size: half the TurtleBot camera's 640 x 480, for speed (README)
+        width: int = 320
+        height: int = 240
         camera_hz: float = 10.0  # Hz; a frame is rendered when due, the last one reused otherwise
         camera_height: float = 0.4  # m, optical centre above the floor
-        camera_tilt: float = 0.0  # rad, downward pitch; the paper's human-robot setting is pi/8
+        camera_tilt: float = PAPER_TILT  # rad, downward pitch (0: level)
         wall_height: float = 2.0  # m, height of the extruded walls
         collision_inset: float = (
             0.5  # grid cells by which collision cylinders are thinner than the bodies
@@ -204,8 +216,9 @@ class PybulletSimulator(Simulator):
         pursuer = create_body(client, robot, radius, PURSUER_HEIGHT)
         self._pursuer = _Mover(client, pursuer, walls, ctx.pursuer, radius, PURSUER_HEIGHT)
         radius = ctx.evader.radius - self._inset
-        evader = create_body(client, person(), radius, EVADER_HEIGHT)
-        self._evader = _Mover(client, evader, walls, ctx.evader, radius, EVADER_HEIGHT)
+        evader = create_person(client, radius, EVADER_HEIGHT)
+        walker = Walker(client, evader)
+        self._evader = _Mover(client, evader, walls, ctx.evader, radius, EVADER_HEIGHT, walker)
         self.labels = {"evader": evader, "pursuer": pursuer, "floor": self.world.floor}
         self.camera = DepthCamera(
             client,

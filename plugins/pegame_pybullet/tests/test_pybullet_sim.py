@@ -99,7 +99,7 @@ def test_a_start_inside_a_wall_is_refused(context):
 
 @pytest.mark.parametrize("tilt", [0.0, math.pi / 8])
 def test_camera_depth_to_a_wall_and_the_floor(context, tilt):
-    sim = make_sim(context, camera_tilt=tilt)
+    sim = make_sim(context, camera_tilt=tilt, width=160, height=120)
     try:
         sim.reset(Pose(0.5, 1.0, 0.0), Pose(3.5, 2.5, 0.0))
         frame = sim.sense(0.0)

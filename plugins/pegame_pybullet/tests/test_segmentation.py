@@ -19,8 +19,10 @@ from pegame_pybullet.sim import PybulletSimulator
 
 @pytest.fixture
 def scene(context):
-    """(sim, detector) on the small map, with a level camera."""
-    sim = PybulletSimulator(PybulletSimulator.Config(), context, np.random.default_rng(0))
+    """(sim, detector) on the small map, with a level camera (the default is the paper's
+    pi/8 down, which sees a person's legs only)."""
+    config = PybulletSimulator.Config(camera_tilt=0.0)
+    sim = PybulletSimulator(config, context, np.random.default_rng(0))
     detector = SegmentationDetector(
         SegmentationDetector.Config(), context, np.random.default_rng(0)
     )
