@@ -32,7 +32,8 @@ from pegame.errors import ConfigError, require
 from pegame.play.session import active
 from pegame.types import Plan, Pose, Velocity
 
-#: what the page may draw besides the map, the evader and the clock
+#: what the page may draw besides the map, the evader and the clock (``show``; by
+#: default the first two, what the paper's HoloLens relayed)
 SHOWN = ("pursuer", "cone", "belief")
 
 
@@ -43,8 +44,7 @@ class HumanEvader(Evader):
 
     @dataclass
     class Config(Evader.Config):
-        # what the page shows the person: any of pursuer, cone, belief ([] shows neither)
-        show: list[str] = field(default_factory=lambda: ["pursuer", "cone"])
+        show: list[str] = field(default_factory=lambda: list(SHOWN[:2]))  # drawn: see SHOWN
 
         def __post_init__(self) -> None:
             super().__post_init__()
