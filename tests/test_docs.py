@@ -52,6 +52,29 @@ def test_the_results_pages_tables_are_those_generated_from_the_committed_tables(
     assert done.returncode == 0, done.stderr
 
 
+def test_a_result_quoted_by_hand_in_a_results_page_is_caught(tmp_path):
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("tables", ROOT / "docs" / "results" / "tables.py")
+    tables = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tables)
+    prose = (
+        "S-R tracks 97.0% at ratio 1, +3.1 pp over smart, in 8 of 9 cells (p_Holm 9.3e-12); "
+        "mean with its 95% bootstrap CI, 40 seeds of 90 s."
+    )
+    assert tables.quoted_by_hand(prose) == ["97.0%", "3.1 pp", "8 of 9", "9.3e-12"]
+    generated = (
+        "holds in <!-- value: h1_cells -->9 of 9<!-- /value --> cells, `0.5%` in code, "
+        "[a link](../x_10%.md)\n<!-- generated: t -->\n| 12.5% |\n<!-- end: t -->"
+    )
+    assert tables.quoted_by_hand(generated) == []
+    page = "holds in <!-- value: h1_cells -->7 of 9<!-- /value --> cells"
+    fresh = tables.regenerate(page, {}, tables.PAPER_TABLE1_VALUES)
+    assert fresh == f"holds in <!-- value: h1_cells -->{tables.holds('H1')}<!-- /value --> cells"
+    with pytest.raises(ValueError, match="unknown values: nowhere"):
+        tables.regenerate("<!-- value: nowhere -->1<!-- /value -->", {}, {})
+
+
 def tutorial_code(page: str, first_line: str) -> str:
     """The Python block of ``docs/<page>`` that starts with ``first_line``."""
     text = (ROOT / "docs" / page).read_text()
