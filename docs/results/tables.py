@@ -359,7 +359,7 @@ def regenerate(
         )
         if not pattern.search(text):
             raise ValueError(f"no '<!-- generated: {name} -->' block in the page")
-        text = pattern.sub(lambda m: m.group(1) + make() + m.group(2), text)
+        text = pattern.sub(lambda m, make=make: m.group(1) + make() + m.group(2), text)
     unknown = set(re.findall(r"<!-- value: (\w+) -->", text)) - set(values)
     if unknown:
         raise ValueError(f"the page quotes unknown values: {', '.join(sorted(unknown))}")
