@@ -59,15 +59,16 @@ class CompareError(PegameError, ValueError):
     """A comparison asked for a factor or a value that the sweep does not have."""
 
 
-def parse_compare(text: str) -> tuple[str, str, str]:
-    """'detector.miss_probability=0,0.3' as (factor, A, B)."""
+def parse_compare(text: str, option: str = "--compare") -> tuple[str, str, str]:
+    """'detector.miss_probability=0,0.3' as (factor, A, B); ``option`` names the command
+    line option in the error."""
     factor, _, values = text.partition("=")
     pair = values.split(",")
     if not factor or len(pair) != 2 or not all(pair):
         raise CompareError(
-            f"--compare {text!r} is not FACTOR=A,B. Give one setting that differs between "
+            f"{option} {text!r} is not FACTOR=A,B. Give one setting that differs between "
             f"the sweep's configurations and two of its values, e.g. "
-            f"--compare detector.miss_probability=0,0.3."
+            f"{option} detector.miss_probability=0,0.3."
         )
     return factor, pair[0], pair[1]
 
@@ -83,13 +84,15 @@ def cell_value(cell: Cell, factor: str) -> Any:
     return getattr(cell, factor) if factor in AXES else cell.factors[factor]
 
 
-def check(cells: list[Cell], factor: str, values: tuple[str, str]) -> None:
-    """Raise :class:`CompareError` unless ``factor`` is a factor of ``cells`` (or a paper
-    axis) with both ``values``."""
+def check(
+    cells: list[Cell], factor: str, values: tuple[str, str], option: str = "--compare"
+) -> None:
+    """Raise :class:`CompareError` (naming the command line ``option``) unless ``factor``
+    is a factor of ``cells`` (or a paper axis) with both ``values``."""
     factors = list(cells[0].factors) if cells else []
     if factor not in factors and factor not in AXES:
         raise CompareError(
-            f"--compare: {factor!r} is not a factor of this sweep (a setting that differs "
+            f"{option}: {factor!r} is not a factor of this sweep (a setting that differs "
             f"between its configurations) nor a paper axis ({', '.join(AXES)}). Its "
             f"factors: {', '.join(factors) or 'none'}."
         )
@@ -97,11 +100,37 @@ def check(cells: list[Cell], factor: str, values: tuple[str, str]) -> None:
     absent = [v for v in values if v not in seen]
     if absent:
         raise CompareError(
-            f"--compare {factor}: no games with {' or '.join(map(repr, absent))}. The values "
+            f"{option} {factor}: no games with {' or '.join(map(repr, absent))}. The values "
             f"of {factor} in this sweep: {', '.join(seen)}."
         )
     if values[0] == values[1]:
-        raise CompareError(f"--compare {factor}: A and B are both {values[0]!r}; give two.")
+        raise CompareError(f"{option} {factor}: A and B are both {values[0]!r}; give two.")
+
+
+def matched(cells: list[Cell], factor: str, a: str, b: str) -> list[tuple[Cell, Cell]]:
+    """(cell of A, cell of B) for every place where both values of ``factor`` have a cell:
+    the same paper axes (those other than ``factor``) and the same other factors; in
+    table order."""
+
+    def place(cell: Cell) -> tuple:
+        rest = tuple(cell.facet[i] for i, f in enumerate(cell.factors) if f != factor)
+        axes = tuple(getattr(cell, axis) for axis in AXES if axis != factor)
+        return axes, rest
+
+    sides = {
+        value: {place(c): c for c in cells if value_text(cell_value(c, factor)) == value}
+        for value in (a, b)
+    }
+    return [(cell_a, sides[b][key]) for key, cell_a in sides[a].items() if key in sides[b]]
+
+
+def cell_place(cell: Cell, factor: str, other: str) -> dict[str, Any]:
+    """A compared row's paper axes; the compared axis, when ``factor`` is one, as
+    'A vs B' (``other`` is B)."""
+    axes = {axis: getattr(cell, axis) for axis in AXES}
+    if factor in AXES:
+        axes[factor] = f"{value_text(getattr(cell, factor))} vs {other}"
+    return axes
 
 
 def compare(
@@ -116,30 +145,14 @@ def compare(
     None when the two sides share no seed (not tested)."""
     check(cells, factor, (a, b))
     others = [f for f in cells[0].factors if f != factor]
-
-    def place(cell: Cell) -> tuple:
-        rest = tuple(cell.facet[i] for i, f in enumerate(cell.factors) if f != factor)
-        axes = tuple(getattr(cell, axis) for axis in AXES if axis != factor)
-        return axes, rest
-
-    sides = {
-        value: {place(c): c for c in cells if value_text(cell_value(c, factor)) == value}
-        for value in (a, b)
-    }
     rows = []
-    for key, cell_a in sides[a].items():
-        cell_b = sides[b].get(key)
-        if cell_b is None:
-            continue
+    for cell_a, cell_b in matched(cells, factor, a, b):
         test = paired_test(
             by_seed(cell_b.games, measure.name), by_seed(cell_a.games, measure.name), "two-sided"
         )
-        axes = {axis: getattr(cell_a, axis) for axis in AXES}
-        if factor in AXES:  # the compared axis: both of its values
-            axes[factor] = f"{value_text(getattr(cell_a, factor))} vs {b}"
         rows.append(
             {
-                **axes,
+                **cell_place(cell_a, factor, b),
                 "factors": {f: cell_a.factors[f] for f in others},
                 "n_a": len(cell_a.games),
                 "n_b": len(cell_b.games),

@@ -195,15 +195,23 @@ def facet_text(factors: dict[str, Any]) -> str:
     return ", ".join(f"{key}={value_text(value)}" for key, value in factors.items())
 
 
-def hypotheses_per_facet(cells: list[Cell]) -> list[dict[str, Any]]:
-    """The three hypotheses per combination of the other factors, each tagged with its
-    ``factors``: three entries when the sweep has no other factors."""
-    tests = []
+def per_facet(
+    cells: list[Cell], tests: Callable[[Rates, Seeded], list[dict[str, Any]]]
+) -> list[dict[str, Any]]:
+    """``tests`` (of a facet's rates and {seed: rate}) per combination of the other
+    factors, each result tagged with its ``factors``."""
+    results = []
     for factors, group in facets(cells):
         rates = {(c.map, c.speed_ratio, c.pairing): c.rates for c in group}
         seeded = {(c.map, c.speed_ratio, c.pairing): by_seed(c.games) for c in group}
-        tests += [{**h, "factors": factors} for h in hypotheses(rates, seeded)]
-    return tests
+        results += [{**h, "factors": factors} for h in tests(rates, seeded)]
+    return results
+
+
+def hypotheses_per_facet(cells: list[Cell]) -> list[dict[str, Any]]:
+    """The three hypotheses per combination of the other factors, each tagged with its
+    ``factors``: three entries when the sweep has no other factors."""
+    return per_facet(cells, hypotheses)
 
 
 def title(h: dict[str, Any]) -> str:

@@ -134,7 +134,7 @@ def test_the_report_logs_each_stage(tmp_path, caplog):
     assert lines[0] == f"loading 2 job dirs below {tmp_path}"
     assert lines[1].startswith("4 games, 1 cells; statistics of tracking_rate")
     assert lines[2:] == [
-        "testing hypotheses H1-H3 on the tracking rate",
+        "testing hypotheses H1-H3 and the trends T1-T2 on the tracking rate",
         "setting our tracking rates beside the paper's Table 1",
         "drawing the figures (PNG and SVG)",
         f"writing 13 files into {tmp_path / 'out'}",
