@@ -104,6 +104,7 @@ OPTIONAL: dict[str, Check] = {
     "t_max": NUMBER,
     "control_hz": NUMBER,
     "decision_hz": NUMBER,
+    "loss_causes": DICT,
 }
 
 
