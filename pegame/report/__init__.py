@@ -21,7 +21,9 @@ beside them), and per cell computes the mean of one measure (``--metric``, one o
 - ``hypotheses.md``: the paper's three hypotheses on the tracking rate (whatever the
   measure), tested per combination of the other factors
   (:mod:`~pegame.report.hypotheses`), unpaired (Mann-Whitney U) and, on the seeds both
-  pairings share, paired (Wilcoxon signed-rank, :mod:`~pegame.report.paired`);
+  pairings share, paired (Wilcoxon signed-rank, :mod:`~pegame.report.paired`); then the
+  paper's trends T1 (tracking rises with v_p/v_e: Jonckheere-Terpstra, and Page's L on
+  common seeds) and T2 (S-S < S-R) (:mod:`~pegame.report.trends`);
 - ``estimation.md`` / ``.csv`` when the games carry an estimation error or N_eff: the
   estimator's measures per cell (:mod:`~pegame.report.estimation`);
 - ``losses.md`` / ``.csv`` and the stacked bars ``loss_causes.png`` / ``.svg`` when the
@@ -30,6 +32,10 @@ beside them), and per cell computes the mean of one measure (``--metric``, one o
   Table 1 with the difference (:mod:`~pegame.report.paper`);
 - with ``--compare FACTOR=A,B`` (repeatable): ``compare_<FACTOR>.md`` / ``.csv``, value B
   of one factor against value A per cell on common seeds (:mod:`~pegame.report.compare`);
+- with ``--noninferior FACTOR=A,B --margin DELTA`` (repeatable, one margin):
+  ``noninferior_<FACTOR>.md`` / ``.csv``, whether A's tracking rate is no worse than B's by
+  more than DELTA per cell, a one-sided paired bootstrap test on common seeds with Holm
+  (:mod:`~pegame.report.noninferiority`);
 - ``report.json``: all of the above, machine-readable.
 
 With a measure other than the tracking rate, the files of that measure (tables, figures,
@@ -81,12 +87,21 @@ from pegame.report.hypotheses import (
     facet_text,
     hypotheses,
     hypotheses_per_facet,
+    per_facet,
     render_hypotheses,
     title,
 )
 from pegame.report.load import ReportError, Sweep, find_job_dirs, load_sweep
 from pegame.report.losses import loss_files
 from pegame.report.measures import MEASURES, TRACKING, Measure, MeasureError, measure
+from pegame.report.noninferiority import (
+    MarginError,
+    check_margin,
+    noninferior,
+    render_noninferior_csv,
+    render_noninferior_md,
+)
+from pegame.report.noninferiority import file_stem as noninferior_stem
 from pegame.report.paper import render_paper_csv, render_paper_md, versus_paper
 from pegame.report.statistics import ALPHA, holm
 from pegame.report.tables import (
@@ -98,12 +113,14 @@ from pegame.report.tables import (
     render_table_md,
     render_table_tex,
 )
+from pegame.report.trends import render_trends, trends
 
 __all__ = [
     "ALPHA",
     "UNTESTED",
     "MEASURES",
     "CompareError",
+    "MarginError",
     "MeasureError",
     "ReportError",
     "bootstrap_ci",
@@ -164,7 +181,7 @@ def aggregate(
     described = [cell.summary(measured.name) for cell in cells]
     if cells and not any(d["n"] for d in described):
         log.warning("no game defines %s: its tables and figures are empty", measured.name)
-    log.info("testing hypotheses H1-H3 on the tracking rate")
+    log.info("testing hypotheses H1-H3 and the trends T1-T2 on the tracking rate")
     return {
         "sweep_dirs": [str(d) for d in dirs],
         "games": len(chosen.games),
@@ -174,6 +191,7 @@ def aggregate(
         "factors": factors,
         "cells": described,
         "hypotheses": hypotheses_per_facet(cells),
+        "trends": per_facet(cells, trends),
         "provenance": provenance(chosen.games, cells),
         "failed_cells": sweep.invalid,
         "failed_games": chosen.failed,
@@ -225,13 +243,17 @@ def write_report(
     comparisons: Sequence[tuple[str, str, str]] = (),
     metric: str = TRACKING.name,
     paper: bool = False,
+    noninferiors: Sequence[tuple[str, str, str]] = (),
+    margin: float | None = None,
 ) -> dict[str, Any]:
     """Aggregate one or more sweep directories and write the tables, figures,
     hypotheses.md and report.json into ``out_dir`` (default: the sweep directory; required
     for several), and per (factor, A, B) of ``comparisons`` compare_<factor>.md / .csv
     (:func:`~pegame.report.compare.compare`), all of the measure ``metric`` (file names
-    with its name unless it is the tracking rate); with ``paper`` also vs_paper.md / .csv.
-    Returns report.json's content."""
+    with its name unless it is the tracking rate); with ``paper`` also vs_paper.md / .csv;
+    per (factor, A, B) of ``noninferiors`` noninferior_<factor>.md / .csv, A against B at
+    the non-inferiority ``margin`` (a fraction of the tracking rate; required with them,
+    :func:`~pegame.report.noninferiority.noninferior`). Returns report.json's content."""
     measured = measure(metric)
     dirs = [Path(d) for d in ([sweep_dirs] if isinstance(sweep_dirs, (str, Path)) else sweep_dirs)]
     if out_dir is None and len(dirs) != 1:
@@ -239,31 +261,41 @@ def write_report(
             f"A report of {len(dirs)} sweep directories needs an output directory (--out)."
         )
     out = Path(out_dir) if out_dir is not None else dirs[0]
-    factors = [factor for factor, _, _ in comparisons]
-    twice = sorted({f for f in factors if factors.count(f) > 1})
-    if twice:
-        raise CompareError(
-            f"--compare names {', '.join(twice)} more than once: one comparison per factor "
-            f"(each writes compare_<factor>.md)."
-        )
+    for option, specs in (("--compare", comparisons), ("--noninferior", noninferiors)):
+        factors = [factor for factor, _, _ in specs]
+        twice = sorted({f for f in factors if factors.count(f) > 1})
+        if twice:
+            raise CompareError(
+                f"{option} names {', '.join(twice)} more than once: one per factor "
+                f"(each writes its own file named after the factor)."
+            )
+    if noninferiors:
+        margin = check_margin(margin)
     for directory in dirs:
         if directory.is_dir():
             log.info("loading %d job dirs below %s", len(find_job_dirs(directory)), directory)
     report, cells = aggregate(load_sweep(dirs), dirs, measured)
     report["comparisons"] = [compare(cells, *spec, measured) for spec in comparisons]
+    report["noninferiority"] = [noninferior(cells, *spec, margin) for spec in noninferiors]
     layout = Layout(cells, report["cells"])
     notes = render_provenance(report["provenance"]) + render_problems(problem_sections(report))
     files: dict[str, str | bytes] = {
         named("table1.md", measured): render_table_md(layout, notes, measured),
         named("table1.csv", measured): render_table_csv(cells, report["cells"]),
         named("table1.tex", measured): render_table_tex(layout, measured),
-        "hypotheses.md": render_hypotheses(report["hypotheses"]),
+        "hypotheses.md": render_hypotheses(report["hypotheses"])
+        + "\n"
+        + render_trends(report["trends"]),
         **extra_tables(report, cells, paper),
     }
     for comparison in report["comparisons"]:
         stem = file_stem(comparison["factor"])
         files[named(f"{stem}.md", measured)] = render_compare_md(comparison)
         files[named(f"{stem}.csv", measured)] = render_compare_csv(comparison)
+    for result in report["noninferiority"]:
+        stem = noninferior_stem(result["factor"])
+        files[f"{stem}.md"] = render_noninferior_md(result)
+        files[f"{stem}.csv"] = render_noninferior_csv(result)
     log.info("drawing the figures (PNG and SVG)")
     for name, fig in figures(cells, report["cells"], measured).items():
         for fmt in ("png", "svg"):
@@ -318,6 +350,23 @@ def main(argv: list[str] | None = None) -> int:
         "(repeatable, one per factor)",
     )
     parser.add_argument(
+        "--noninferior",
+        action="append",
+        default=[],
+        metavar="FACTOR=A,B",
+        help="test in every cell that value A of a factor tracks no worse than value B by more "
+        "than --margin (one-sided paired bootstrap on common seeds, Holm across the cells; "
+        "on the tracking rate); writes noninferior_FACTOR.md/.csv (repeatable, one per factor)",
+    )
+    parser.add_argument(
+        "--margin",
+        type=float,
+        default=None,
+        metavar="DELTA",
+        help="the non-inferiority margin of --noninferior, a fraction of the tracking rate "
+        "(0.02: 2 percentage points); required with it",
+    )
+    parser.add_argument(
         "--metric",
         default=TRACKING.name,
         metavar="NAME",
@@ -334,8 +383,13 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         comparisons = [parse_compare(text) for text in args.compare]
+        noninferiors = [parse_compare(text, "--noninferior") for text in args.noninferior]
+        if noninferiors:
+            check_margin(args.margin)
+        elif args.margin is not None:
+            parser.error("--margin is the margin of --noninferior FACTOR=A,B; give both")
         measured = measure(args.metric)
-    except (CompareError, MeasureError) as error:
+    except (CompareError, MarginError, MeasureError) as error:
         parser.error(str(error))
     for directory in args.sweep_dirs:
         if not directory.is_dir():
@@ -344,7 +398,15 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("several sweep directories need --out")
     logging.basicConfig(level=logging.INFO, format="%(levelname)s: %(message)s")
     try:
-        report = write_report(args.sweep_dirs, args.out, comparisons, args.metric, args.paper)
+        report = write_report(
+            args.sweep_dirs,
+            args.out,
+            comparisons,
+            args.metric,
+            args.paper,
+            noninferiors,
+            args.margin,
+        )
     except PegameError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
@@ -361,7 +423,7 @@ def main(argv: list[str] | None = None) -> int:
             f"tables, figures and comparisons of {measured.name} -> "
             f"{named('table1.md', measured)}; the hypotheses are tested on the tracking rate"
         )
-    for h in report["hypotheses"]:
+    for h in report["hypotheses"] + report["trends"]:
         paired = h["summary_paired"]
         print(
             f"{title(h)}: {h['summary']['text']} by {h['test']}; "
@@ -373,6 +435,13 @@ def main(argv: list[str] | None = None) -> int:
             f"{c['factor']}: {c['b']} against {c['a']}: significant in {s['significant']} of "
             f"{s['tested']} tested cells -> "
             f"{named(file_stem(c['factor']) + '.md', measured)}"
+        )
+    for n in report["noninferiority"]:
+        s = n["summary"]
+        print(
+            f"{n['factor']}: {n['a']} no worse than {n['b']} by more than "
+            f"{100 * n['margin']:g} points: non-inferior in {s['noninferior']} of "
+            f"{s['tested']} tested cells -> {noninferior_stem(n['factor'])}.md"
         )
     if "estimation" in report:
         print("the estimator's error while unseen, N_eff and resamplings per cell -> estimation.md")
