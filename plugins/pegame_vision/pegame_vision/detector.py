@@ -1,9 +1,12 @@
 """``detector=vision``: detect the evader by colour, track it with Lucas-Kanade, place it
 with the depth image (paper, Sec. "Object tracking from static camera").
 
-Reads only what an RGB-D camera driver gives: ``frame.rgb``, ``frame.depth`` and the
-calibration (``frame.intrinsics``, ``frame.camera_to_map``); never the simulator's
-segmentation, labels or ``evader_truth``. Each frame either
+:class:`TrackingDetector` holds what it shares with ``detector=person``
+(:mod:`pegame_vision.person`): the tracking, the placement and the perception model;
+:class:`VisionDetector` adds the colour model. Reads only what an RGB-D camera driver
+gives: ``frame.rgb``, ``frame.depth`` and the calibration (``frame.intrinsics``,
+``frame.camera_to_map``); never the simulator's segmentation, labels or ``evader_truth``.
+Each frame either
 
 - detects: the pixels that match the colour model (:class:`pegame_vision.colour.
   ColourModel`), in components of at least ``min_component`` px, at least ``min_pixels``
@@ -63,25 +66,31 @@ class RGBD(NamedTuple):
     camera_to_map: np.ndarray
 
 
-class VisionDetector(Detector):
-    """Colour-model detection and Lucas-Kanade tracking on RGB-D frames."""
+def back_project(images: RGBD, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """(3, N) map-frame points (m, z up from the floor) of the pixels at ``rows``, ``cols``
+    through their depth; nan where a pixel has no depth (inf: no return)."""
+    k, transform = images.intrinsics, images.camera_to_map
+    z = images.depth[rows, cols].astype(float)
+    optical = np.stack(
+        [(cols + 0.5 - k[0, 2]) * z / k[0, 0], (rows + 0.5 - k[1, 2]) * z / k[1, 1], z]
+    )
+    with np.errstate(invalid="ignore"):  # inf depth gives nan
+        points: np.ndarray = transform[:3, :3] @ optical + transform[:3, 3:]
+    return points
 
-    description = "OpenCV on RGB-D: colour model of the evader's clothing, Lucas-Kanade tracking."
+
+class TrackingDetector(Detector):
+    """What the RGB-D detectors share: a detection on some frames (:meth:`_find`, the
+    subclass's), Lucas-Kanade tracking in between with the subclass's appearance test
+    (:meth:`_accept`), placement by depth back-projection, then the perception model."""
+
+    #: the detector's name in a config (``detector=...``), for messages
+    entry: ClassVar[str] = ""
 
     @dataclass
     class Config(PerceptionConfig):
         # The rendered pixels already show occlusion: no occlusion miss here.
         occlusion: ClassVar[bool] = False
-        colours: list[str] = field(
-            default_factory=lambda: list(EVADER_COLOURS)
-        )  # '#rrggbb', the evader's
-        hue_tolerance: float = 12.0  # degrees of hue around each colour
-        min_saturation: float = (
-            0.25  # HSV saturation in [0, 1] below which a pixel has no reliable hue
-        )
-        min_value: float = 0.08  # HSV value in [0, 1] below which a pixel is too dark to judge
-        min_pixels: int = 12  # matching pixels needed for a detection
-        min_component: int = 3  # px; smaller matching specks are noise
         redetect_every: int = 5  # detect on every K-th frame while tracking (1: every frame)
         min_features: int = 4  # fewer tracked features than this: re-detect at once
         max_features: int = 40  # features tracked at most
@@ -89,38 +98,8 @@ class VisionDetector(Detector):
 
         def __post_init__(self) -> None:
             super().__post_init__()
-            require(
-                len(self.colours) > 0,
-                "colours",
-                "a non-empty list of '#rrggbb'",
-                self.colours,
-            )
-            for colour in self.colours:
-                try:
-                    parse_hex(colour)
-                except ValueError:
-                    require(False, "colours", "colours written '#rrggbb'", colour)
-            require(
-                0 < self.hue_tolerance <= 90,
-                "hue_tolerance",
-                "(0, 90] degrees",
-                self.hue_tolerance,
-            )
-            for key in ("min_saturation", "min_value"):
-                require(0 <= getattr(self, key) <= 1, key, "[0, 1]", getattr(self, key))
-            for key in (
-                "min_pixels",
-                "min_component",
-                "redetect_every",
-                "min_features",
-                "max_features",
-            ):
-                require(
-                    getattr(self, key) >= 1,
-                    key,
-                    "a whole number >= 1",
-                    getattr(self, key),
-                )
+            for key in ("redetect_every", "min_features", "max_features"):
+                require(getattr(self, key) >= 1, key, "a whole number >= 1", getattr(self, key))
             require(
                 self.surface_offset >= 0,
                 "surface_offset",
@@ -128,11 +107,16 @@ class VisionDetector(Detector):
                 self.surface_offset,
             )
 
+    def _find(self, images: RGBD, gray: np.ndarray) -> tuple[Box, np.ndarray] | None:
+        """The evader's box (px) and its pixels (bool (H, W)) in a fresh detection, or None."""
+        raise NotImplementedError
+
+    def _accept(self, images: RGBD, points: np.ndarray) -> np.ndarray:
+        """Bool (N,): whether the tracked ``points`` (N, 2) (x, y) px still show the evader."""
+        raise NotImplementedError
+
     def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         super().__init__(config, context, rng)
-        self.model = ColourModel(
-            config.colours, config.hue_tolerance, config.min_saturation, config.min_value
-        )
         self.tracker = BoxTracker(config.max_features)
         self.perception = Perception(config, context, rng)
         self.reset()
@@ -159,11 +143,11 @@ class VisionDetector(Detector):
         return self._delivered
 
     def _see(self, frame: SensorFrame) -> Detection | None:
-        """This frame's detection by colour or tracking, before the perception model."""
+        """This frame's detection (:meth:`_find`) or tracking, before the perception model."""
         rgb, depth, k, to_map = frame.rgb, frame.depth, frame.intrinsics, frame.camera_to_map
         if rgb is None or depth is None or k is None or to_map is None:
             raise ConfigError(
-                "detector=vision needs RGB-D frames with the camera calibration (sim=pybullet); "
+                f"detector={self.entry} needs RGB-D frames with the camera calibration (sim=pybullet); "
                 "use detector=oracle with sim=grid."
             )
         images = RGBD(rgb, depth, k, to_map)
@@ -180,9 +164,7 @@ class VisionDetector(Detector):
         detect again."""
         if self._since_detection >= self.config.redetect_every:
             return None
-        survivors = self.tracker.step(
-            gray, lambda points: self.model.matches_at(images.rgb, points)
-        )
+        survivors = self.tracker.step(gray, lambda points: self._accept(images, points))
         if survivors < self.config.min_features:
             self._tracking = False
             return None
@@ -194,13 +176,13 @@ class VisionDetector(Detector):
         return box, points[:, 1].astype(int), points[:, 0].astype(int)
 
     def _detect(self, images: RGBD, gray: np.ndarray) -> Samples | None:
-        """(box, rows, cols) of the pixels matching the colour model, or None."""
-        mask = find_blobs(self.model.mask(images.rgb), self.config.min_component)
-        rows, cols = np.nonzero(mask)
+        """(box, rows, cols) of a fresh detection (:meth:`_find`), or None."""
         self._tracking = False
-        if rows.size < self.config.min_pixels:
+        found = self._find(images, gray)
+        if found is None:
             return None
-        box = (float(cols.min()), float(rows.min()), float(cols.max() + 1), float(rows.max() + 1))
+        box, mask = found
+        rows, cols = np.nonzero(mask)
         self._tracking = self.tracker.start(gray, np.array(box), mask) >= self.config.min_features
         self._since_detection = 1  # frames since (and including) this detection
         return box, rows, cols
@@ -210,14 +192,9 @@ class VisionDetector(Detector):
     ) -> Detection | None:
         """The detection from the box (px) and the evader's sample pixels, or None when too
         few samples have a depth within range."""
-        k, transform = images.intrinsics, images.camera_to_map
         z = images.depth[rows, cols].astype(float)
-        optical = np.stack(
-            [(cols + 0.5 - k[0, 2]) * z / k[0, 0], (rows + 0.5 - k[1, 2]) * z / k[1, 1], z]
-        )
-        with np.errstate(invalid="ignore"):  # inf depth (no return) gives nan, dropped below
-            x, y, _ = transform[:3, :3] @ optical + transform[:3, 3:]
-        origin = transform[:2, 3]
+        x, y, _ = back_project(images, rows, cols)
+        origin = images.camera_to_map[:2, 3]
         ranges = np.hypot(x - origin[0], y - origin[1])
         camera = self.context.camera
         valid = np.isfinite(z) & (ranges >= camera.near) & (ranges <= camera.far)
@@ -234,3 +211,70 @@ class VisionDetector(Detector):
             depth=float(np.median(z[valid])),
             position=(float(position[0]), float(position[1])),
         )
+
+
+class VisionDetector(TrackingDetector):
+    """Colour-model detection and Lucas-Kanade tracking on RGB-D frames."""
+
+    description = "OpenCV on RGB-D: colour model of the evader's clothing, Lucas-Kanade tracking."
+    entry = "vision"
+
+    @dataclass
+    class Config(TrackingDetector.Config):
+        colours: list[str] = field(
+            default_factory=lambda: list(EVADER_COLOURS)
+        )  # '#rrggbb', the evader's
+        hue_tolerance: float = 12.0  # degrees of hue around each colour
+        min_saturation: float = (
+            0.25  # HSV saturation in [0, 1] below which a pixel has no reliable hue
+        )
+        min_value: float = 0.08  # HSV value in [0, 1] below which a pixel is too dark to judge
+        min_pixels: int = 12  # matching pixels needed for a detection
+        min_component: int = 3  # px; smaller matching specks are noise
+
+        def __post_init__(self) -> None:
+            super().__post_init__()
+            require(
+                len(self.colours) > 0,
+                "colours",
+                "a non-empty list of '#rrggbb'",
+                self.colours,
+            )
+            for colour in self.colours:
+                try:
+                    parse_hex(colour)
+                except ValueError:
+                    require(False, "colours", "colours written '#rrggbb'", colour)
+            require(
+                0 < self.hue_tolerance <= 90,
+                "hue_tolerance",
+                "(0, 90] degrees",
+                self.hue_tolerance,
+            )
+            for key in ("min_saturation", "min_value"):
+                require(0 <= getattr(self, key) <= 1, key, "[0, 1]", getattr(self, key))
+            for key in ("min_pixels", "min_component"):
+                require(getattr(self, key) >= 1, key, "a whole number >= 1", getattr(self, key))
+
+    def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
+        self.model = ColourModel(
+            config.colours, config.hue_tolerance, config.min_saturation, config.min_value
+        )
+        super().__init__(config, context, rng)
+
+    def _find(self, images: RGBD, gray: np.ndarray) -> tuple[Box, np.ndarray] | None:
+        """The pixels matching the colour model, in components of at least
+        ``min_component`` px and at least ``min_pixels`` of them, and their box."""
+        mask = find_blobs(self.model.mask(images.rgb), self.config.min_component)
+        rows, cols = np.nonzero(mask)
+        if rows.size < self.config.min_pixels:
+            return None
+        return (
+            float(cols.min()),
+            float(rows.min()),
+            float(cols.max() + 1),
+            float(rows.max() + 1),
+        ), mask
+
+    def _accept(self, images: RGBD, points: np.ndarray) -> np.ndarray:
+        return self.model.matches_at(images.rgb, points)

@@ -1,9 +1,11 @@
-"""``detector=vision`` measured against ``detector=segmentation`` on played games.
+"""``detector=vision`` or ``detector=person`` measured against ``detector=segmentation``
+on played games.
 
 Games are played in PyBullet (``sim=pybullet``, needs pegame-pybullet) with the reference
 segmentation detector driving the smart pursuer, so that both detectors see the same
-frames whatever the vision detector does; the vision detector runs beside it on every
-frame. Each frame falls in one of three classes:
+frames whatever the detector under test does; it runs beside the reference on every
+frame, and its latency is the wall-clock time of its ``detect`` on each new frame. Each
+frame falls in one of three classes:
 
 - positive: the reference sees the evader within ``max_range`` m (horizontal distance
   from the camera) with at least ``min_visible`` of its body visible (occlusion and the
@@ -23,6 +25,7 @@ from __future__ import annotations
 
 import math
 import tempfile
+import time
 from collections.abc import Iterable, Mapping
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
@@ -68,6 +71,8 @@ class _Judge(Detector):
         self.reference, self.vision, self.sim = reference, vision, sim
         self.max_range, self.min_visible = max_range, min_visible
         self.rows: list[Row] = []
+        self.latencies: list[float] = []  # s, the detector under test's detect per new frame
+        self._frame: SensorFrame | None = None
 
     def reset(self) -> None:
         self.reference.reset()
@@ -78,7 +83,11 @@ class _Judge(Detector):
         if evader is None:
             raise RuntimeError("The evaluation needs frames that carry the evader's true pose.")
         truth = self.reference.detect(frame)
+        start = time.perf_counter()
         seen = self.vision.detect(frame)
+        if frame is not self._frame:  # a reused frame costs nothing
+            self.latencies.append(time.perf_counter() - start)
+            self._frame = frame
         if truth is None:
             kind = "negative"
         elif (
@@ -101,16 +110,18 @@ def evaluate(
     iou_threshold: float = 0.5,
     vision: Mapping[str, Any] | None = None,
     overrides: Iterable[str] = (),
+    detector: str = "vision",
 ) -> dict[str, Any]:
-    """Precision, recall and mean box IoU of ``detector=vision`` (with the parameters in
-    ``vision``, defaults otherwise) against ``detector=segmentation`` over S-S games on
-    ``env``, one per seed, ``t_max`` s each, the game config changed by ``overrides``
-    (e.g. ``sim.camera_tilt=0.3927``); see the module docstring."""
+    """Precision, recall, mean box IoU and latency of ``detector`` (``vision`` or ``person``,
+    with the parameters in ``vision``, defaults otherwise) against ``detector=segmentation``
+    over S-S games on ``env``, one per seed, ``t_max`` s each, the game config changed by
+    ``overrides`` (e.g. ``sim.camera_tilt=0``); see the module docstring. The scores are
+    named ``<detector>_precision`` and so on."""
     from pegame_pybullet.sim import PybulletSimulator
 
-    vision_cls = registry.load("detector", "vision")
+    vision_cls = registry.load("detector", detector)
     vision_config = registry.make_config("detector", vision_cls, dict(vision or {}))
-    rows = []
+    rows, latencies = [], []
     with tempfile.TemporaryDirectory() as out:
         for seed in seeds:
             game = Game(
@@ -128,17 +139,21 @@ def evaluate(
                     ]
                 )
             )
-            detector = vision_cls(vision_config, game.context, np.random.default_rng(seed))
+            tested = vision_cls(vision_config, game.context, np.random.default_rng(seed))
             sim = PybulletSimulator.narrow(game.plugins.sim)  # the games' sim=pybullet
-            judge = _Judge(game.plugins.detector, detector, sim, max_range, min_visible)
+            judge = _Judge(game.plugins.detector, tested, sim, max_range, min_visible)
             game.plugins = replace(game.plugins, detectors=((judge,),))
             game.play(out)
             rows += judge.rows
-    return _score(rows, iou_threshold)
+            latencies += judge.latencies
+    return _score(rows, iou_threshold, latencies, detector)
 
 
-def _score(rows: list[Row], iou_threshold: float) -> dict[str, Any]:
-    """The scores of recorded (kind, reference, vision, true evader pose) rows."""
+def _score(
+    rows: list[Row], iou_threshold: float, latencies: list[float], name: str = "vision"
+) -> dict[str, Any]:
+    """The scores of recorded (kind, reference, vision, true evader pose) rows and the
+    detector's latencies (s), named ``<name>_precision`` and so on."""
     positives = [  # a positive frame has the reference's detection
         (truth, seen, evader)
         for kind, truth, seen, evader in rows
@@ -153,10 +168,12 @@ def _score(rows: list[Row], iou_threshold: float) -> dict[str, Any]:
     ]
     errors = [math.hypot(seen.position[0] - e.x, seen.position[1] - e.y) for seen, e in matched]
     return {
-        "vision_precision": len(matched) / len(judged) if judged else None,
-        "vision_recall": len(matched) / len(positives) if positives else None,
-        "vision_iou": float(np.mean(overlaps)) if overlaps else None,
-        "vision_position_error_m": float(np.median(errors)) if errors else None,
+        f"{name}_precision": len(matched) / len(judged) if judged else None,
+        f"{name}_recall": len(matched) / len(positives) if positives else None,
+        f"{name}_iou": float(np.mean(overlaps)) if overlaps else None,
+        f"{name}_position_error_m": float(np.median(errors)) if errors else None,
+        f"{name}_latency_ms": 1e3 * float(np.median(latencies)) if latencies else None,
+        f"{name}_latency_p95_ms": 1e3 * float(np.quantile(latencies, 0.95)) if latencies else None,
         "frames": len(rows),
         "positives": len(positives),
         "negatives": sum(1 for row in rows if row[0] == "negative"),

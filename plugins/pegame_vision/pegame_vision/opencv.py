@@ -6,7 +6,7 @@ try:
     import cv2
 except ModuleNotFoundError as exc:
     raise ModuleNotFoundError(
-        "No module named 'cv2': pegame-vision needs OpenCV, pip install 'opencv-python-headless>=4.8'",
+        "No module named 'cv2': pegame-vision needs OpenCV, pip install 'opencv-contrib-python-headless>=4.8'",
         name="cv2",
     ) from exc
 
