@@ -44,17 +44,24 @@ Only the detector knows what its raw detection is; it calls :meth:`Perception.de
 with a function that captures one (applying the per-detection parts: range, misses,
 noise, through :meth:`Perception.degrade` or the building blocks), and the pipeline adds
 rate, latency, bursts and false positives.
+
+The pipeline's schedule (:func:`frame_due`, :func:`deliver_frame`, on a
+:class:`Pipeline` of a batch of detectors) and the range and occlusion miss chance
+(:func:`miss_chance`) are numba kernels: a :class:`Perception` runs them on a batch of
+one, the batched game (:mod:`pegame.vector`) on its games, so the two are one model.
+The results in flight are the caller's (a slot index per result: Python objects here,
+rows of arrays in the batched game).
 """
 
 from __future__ import annotations
 
 import math
-from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, NamedTuple
 
 import numpy as np
+from numba import njit
 
 from pegame.errors import ConfigError, require
 from pegame.types import XY, BoundingBox, Camera, Detection, Pose, wrap_angle
@@ -70,6 +77,9 @@ TIME_TOLERANCE = 1e-9
 PERSON_HEIGHT = 1.7
 #: the generators the parts draw from, one each, spawned from the detector's in this order
 PARTS = ("burst", "range", "bearing", "false_positive", "independent", "noise")
+#: columns of a pipeline's clock: the first capture's time (s; NaN before it), the frames
+#: counted from it, the last capture's time (s; NaN before it)
+FIRST, CAPTURES, LAST = range(3)
 
 
 @dataclass
@@ -156,6 +166,32 @@ class PerceptionConfig:
             )
 
 
+def capture_period(config: PerceptionConfig, control_dt: float) -> float:
+    """The time (s) between captures: 1 / ``rate``, or the control period ``control_dt``."""
+    return control_dt if config.rate is None else 1.0 / config.rate
+
+
+def runs_pipeline(config: PerceptionConfig) -> bool:
+    """Whether any pipeline part is on (rate, latency, bursts, false positives); else
+    each tick delivers its own capture."""
+    return not (
+        config.rate is None
+        and config.latency == 0
+        and config.burst_miss_fraction == 0
+        and config.false_positive_rate == 0
+    )
+
+
+def misses_by_range_or_occlusion(config: PerceptionConfig) -> bool:
+    """Whether the range or the occlusion miss is on (they draw from the 'range' part)."""
+    return config.miss_range_start is not None or config.occlusion_miss > 0
+
+
+def part_generators(rng: np.random.Generator) -> dict[str, np.random.Generator]:
+    """The parts' generators (:data:`PARTS`), spawned from the detector's ``rng``."""
+    return dict(zip(PARTS, rng.spawn(len(PARTS))))
+
+
 def detection_range(config: PerceptionConfig, camera: Camera) -> float:
     """The detection range (m): ``detection_range``, or the camera's ``far`` when null."""
     return camera.far if config.detection_range is None else config.detection_range
@@ -200,6 +236,123 @@ def hidden_fraction(
     return hidden / len(SILHOUETTE)
 
 
+class Pipeline(NamedTuple):
+    """The pipelines of a batch of detectors, first axis the detector (a game's).
+
+    clock (N, 3) float64: FIRST, CAPTURES, LAST; due (N, K) float64: the delivery times
+    (s) of the results in flight, a ring of K slots (:func:`pipeline_slots`) starting at
+    head (N,) int64 and holding size (N,) int64 of them.
+    """
+
+    clock: np.ndarray
+    due: np.ndarray
+    head: np.ndarray
+    size: np.ndarray
+
+
+def pipeline_slots(latency: float, period: float) -> int:
+    """Slots enough for the results in flight: at most one capture per ``period`` s, each
+    held ``latency`` s."""
+    return int(math.floor(latency / period + TIME_TOLERANCE)) + 2
+
+
+def new_pipeline(detectors: int, slots: int) -> Pipeline:
+    """Empty pipelines (:func:`reset_pipeline`) of ``detectors`` detectors."""
+    pipeline = Pipeline(
+        np.empty((detectors, 3)),
+        np.zeros((detectors, slots)),
+        np.zeros(detectors, np.int64),
+        np.zeros(detectors, np.int64),
+    )
+    reset_pipeline(pipeline, np.arange(detectors))
+    return pipeline
+
+
+def reset_pipeline(pipeline: Pipeline, detectors: np.ndarray | int) -> None:
+    """Start a new game in the pipelines ``detectors`` (indices): nothing captured, nothing
+    in flight."""
+    pipeline.clock[detectors] = (math.nan, 0.0, math.nan)
+    pipeline.head[detectors] = 0
+    pipeline.size[detectors] = 0
+
+
+@njit(cache=True)
+def frame_due(
+    clock: np.ndarray, k: int, time: float, period: float, rated: bool
+) -> tuple[bool, float]:
+    """Whether detector ``k`` captures a frame at ``time`` (s): every call without a rate
+    (``rated`` False), else at whole capture periods ``period`` (s) from its first
+    capture (counted, not summed, so the schedule does not drift); and the time (s)
+    since its last capture (``period`` before the first). ``clock``: Pipeline.clock."""
+    if math.isnan(clock[k, FIRST]):
+        clock[k, FIRST] = time
+    due = not rated or time >= clock[k, FIRST] + clock[k, CAPTURES] * period - TIME_TOLERANCE
+    last = clock[k, LAST]
+    return due, period if math.isnan(last) else time - last
+
+
+@njit(cache=True)
+def deliver_frame(
+    clock: np.ndarray,
+    due: np.ndarray,
+    head: np.ndarray,
+    size: np.ndarray,
+    k: int,
+    time: float,
+    period: float,
+    rated: bool,
+    latency: float,
+    captured: bool,
+) -> tuple[int, int, float]:
+    """Detector ``k``'s pipeline (the arrays of a :class:`Pipeline`) at ``time`` (s) after
+    :func:`frame_due`: a frame ``captured`` goes in flight for ``latency`` s in the slot
+    returned first (-1 when none was captured), and the frames a rate skips are counted;
+    the second slot returned is that of the last result delivered by ``time`` (-1: none,
+    the held result stays). The caller stores the captured result in its slot before it
+    reads the delivered one (with no latency they are the same). Third: a time (s) before
+    which the pipeline certainly does nothing (no frame due, no result delivered; -inf
+    without a rate), two tolerances before its next event, so that a caller may skip the
+    kernels until then and play the same."""
+    slots = due.shape[1]
+    slot_in = -1
+    if captured:
+        slot_in = (head[k] + size[k]) % slots
+        due[k, slot_in] = time + latency
+        size[k] += 1
+        clock[k, LAST] = time
+        while rated and clock[k, FIRST] + clock[k, CAPTURES] * period <= time + TIME_TOLERANCE:
+            clock[k, CAPTURES] += 1.0  # past this frame, and past the frames a high rate skips
+    slot_out = -1
+    while size[k] > 0 and due[k, head[k]] <= time + TIME_TOLERANCE:
+        slot_out = head[k]
+        head[k] = (slot_out + 1) % slots
+        size[k] -= 1
+    quiet = clock[k, FIRST] + clock[k, CAPTURES] * period if rated else -math.inf
+    if size[k] > 0:
+        quiet = min(quiet, due[k, head[k]])
+    return slot_in, slot_out, quiet - 2.0 * TIME_TOLERANCE
+
+
+@njit(cache=True)
+def miss_chance(
+    distance: float,
+    hidden: float,
+    reach: float,
+    start: float,
+    at_range: float,
+    occlusion: float,
+) -> float:
+    """The range and occlusion miss chance 1 - (1 - p_r)(1 - p_o) (module docstring) of a
+    body ``distance`` m away with a ``hidden`` fraction of its silhouette out of view:
+    ``reach`` the detection range (m), ``start`` miss_range_start (m; NaN: no range
+    misses), ``at_range`` miss_at_range, ``occlusion`` occlusion_miss."""
+    p_range = 0.0
+    if not math.isnan(start):
+        ramp = (distance - start) / (reach - start)
+        p_range = at_range * min(1.0, max(0.0, ramp))
+    return 1.0 - (1.0 - p_range) * (1.0 - occlusion * hidden)
+
+
 class Perception:
     """One detector's perception model (module docstring) for one game at a time.
 
@@ -221,27 +374,21 @@ class Perception:
         self.camera = context.camera
         self.body_height, self.camera_height = body_height, camera_height
         self.range = detection_range(config, context.camera)
-        self.rngs = dict(zip(PARTS, rng.spawn(len(PARTS))))
-        self.period = context.control_dt if config.rate is None else 1.0 / config.rate
-        # Whether the range or the occlusion miss is on.
-        self.misses_by_range_or_occlusion = (
-            config.miss_range_start is not None or config.occlusion_miss > 0
-        )
+        self.rngs = part_generators(rng)
+        self.period = capture_period(config, context.control_dt)
+        self.rated = config.rate is not None
+        self.miss_start = math.nan if config.miss_range_start is None else config.miss_range_start
+        self.pipeline = new_pipeline(1, pipeline_slots(config.latency, self.period))
+        self.misses_by_range_or_occlusion = misses_by_range_or_occlusion(config)
         # Every pipeline part off: each tick delivers its own capture, nothing to hold.
-        self.passthrough = (
-            config.rate is None
-            and config.latency == 0
-            and config.burst_miss_fraction == 0
-            and config.false_positive_rate == 0
-        )
+        self.passthrough = not runs_pipeline(config)
         self.reset()
 
     def reset(self) -> None:
         """Start a new game: empty pipeline, nothing held, the burst chain undrawn."""
-        self._first_capture: float | None = None
-        self._captures = 0  # frames captured since the first, which fix the next one's time
-        self._last_capture: float | None = None
-        self._pending: deque[tuple[float, Detection | None]] = deque()
+        reset_pipeline(self.pipeline, 0)
+        self._quiet_until = -math.inf  # s, see deliver_frame
+        self._in_flight: list[Detection | None] = [None] * self.pipeline.due.shape[1]
         self._held: Detection | None = None
         self._bursting: bool | None = None
 
@@ -262,30 +409,26 @@ class Perception:
         simulator's calibration knows it)."""
         if self.passthrough:
             return capture()
-        if self._first_capture is None:
-            self._first_capture = time
-        # Without a rate every tick captures; with one, frames are due at whole periods
-        # from the first (counted, not summed, so the schedule does not drift).
-        due = self.config.rate is None or (
-            time >= self._first_capture + self._captures * self.period - TIME_TOLERANCE
-        )
+        if time < self._quiet_until:  # between events: the kernels would do nothing
+            return self._held
+        clock, due_times, head, size = self.pipeline
+        due, dt = frame_due(clock, 0, time, self.period, self.rated)
+        result = None
         if due:
-            dt = self.period if self._last_capture is None else time - self._last_capture
             result = capture()
             if self._burst_step(dt):
                 result = None
             if result is None:
                 height = self.camera_height if camera_height is None else camera_height
                 result = self._false_positive(dt, pose, height)
-            self._pending.append((time + self.config.latency, result))
-            self._last_capture = time
-            while (
-                self.config.rate is not None
-                and self._first_capture + self._captures * self.period <= time + TIME_TOLERANCE
-            ):
-                self._captures += 1  # past this frame, and past the frames a high rate skips
-        while self._pending and self._pending[0][0] <= time + TIME_TOLERANCE:
-            self._held = self._pending.popleft()[1]
+        latency = self.config.latency
+        slot_in, slot_out, self._quiet_until = deliver_frame(
+            clock, due_times, head, size, 0, time, self.period, self.rated, latency, due
+        )
+        if slot_in >= 0:
+            self._in_flight[slot_in] = result
+        if slot_out >= 0:
+            self._held = self._in_flight[slot_out]
         return self._held
 
     def _burst_step(self, dt: float) -> bool:
@@ -332,12 +475,11 @@ class Perception:
 
     def miss_chance(self, distance: float, hidden: float = 0.0) -> float:
         """The range and occlusion miss chance at ``distance`` m with a ``hidden`` fraction of
-        the silhouette out of view: 1 - (1 - p_r)(1 - p_o) (module docstring)."""
-        cfg, p_range = self.config, 0.0
-        if cfg.miss_range_start is not None:
-            ramp = (distance - cfg.miss_range_start) / (self.range - cfg.miss_range_start)
-            p_range = cfg.miss_at_range * min(1.0, max(0.0, ramp))
-        return 1.0 - (1.0 - p_range) * (1.0 - cfg.occlusion_miss * hidden)
+        the silhouette out of view: 1 - (1 - p_r)(1 - p_o) (:func:`miss_chance`)."""
+        cfg = self.config
+        return miss_chance(
+            distance, hidden, self.range, self.miss_start, cfg.miss_at_range, cfg.occlusion_miss
+        )
 
     def missed_by_range(self, distance: float, hidden: float = 0.0) -> bool:
         """Draw the range and occlusion miss (no draw when both are off)."""

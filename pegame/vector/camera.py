@@ -5,11 +5,17 @@ the ground truth in_view, the same tests and float operations as the plain code.
   samples, found in a vectorised pass);
 - :func:`point_in_view` and :func:`body_in_view` are :func:`pegame.visibility.in_view` and
   :func:`pegame.visibility.body_in_view`;
-- :func:`detect` is the oracle detector with every part of the perception model off
+- :func:`hidden_fraction` is :func:`pegame.detectors.perception.hidden_fraction`;
+- :func:`detect` is the oracle detector's capture
   (:class:`pegame.detectors.oracle.OracleDetector`: FOV, range and line of sight of the
-  evader's centre, then the pinhole box and the depth back-projection);
+  evader's centre, the range and occlusion misses of the perception model
+  (:func:`pegame.detectors.perception.miss_chance`, each game's 'range' stream drawn
+  ahead), then the pinhole box and the depth back-projection);
 - :func:`sense` is the loop's ``_sense`` (detection, then in_view) with the pursuer
-  observation's memory of the last detection.
+  observation's memory of the last detection; the detection goes through the perception
+  model's pipeline (rate and latency: :func:`pegame.detectors.perception.frame_due` and
+  :func:`pegame.detectors.perception.deliver_frame`, the kernels the scalar detector runs
+  on a batch of one) when it runs.
 
 Python's ``math.hypot`` and :func:`pegame.types.wrap_angle` come from
 :mod:`pegame.numerics`. ``tests/vector/test_kernels.py`` compares them with the plain
@@ -23,6 +29,7 @@ import math
 import numpy as np
 from numba import njit
 
+from pegame.detectors.perception import deliver_frame, frame_due, miss_chance
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.numerics import (
     cell_by_division,
@@ -46,9 +53,17 @@ from pegame.vector.state import (
     FOV,
     IMAGE_HEIGHT,
     IMAGE_WIDTH,
+    LATENCY,
+    MISS_AT_RANGE,
+    MISS_START,
+    MISSES,
     NEAR,
+    OCCLUSION_MISS,
+    PERIOD,
+    PIPELINE,
     PURSUER,
     RADIUS,
+    RATED,
     SEEN_X,
     SEEN_Y,
     BatchState,
@@ -211,21 +226,53 @@ def body_in_view(
 
 
 @njit(cache=True, inline="always")
+def hidden_fraction(
+    frame: np.ndarray,
+    blocked: np.ndarray,
+    values: np.ndarray,
+    camera: np.ndarray,
+    px: float,
+    py: float,
+    ptheta: float,
+    x: float,
+    y: float,
+    radius: float,
+) -> float:
+    """:func:`pegame.detectors.perception.hidden_fraction`: the fraction of the SILHOUETTE
+    points of the body of ``radius`` m at (x, y) not in view of the camera at (px, py,
+    ptheta)."""
+    dx, dy = x - px, y - py
+    distance = hypot(dx, dy)
+    ax, ay = (-dy / distance, dx / distance) if distance > 0.0 else (0.0, 0.0)
+    hidden = 0
+    for k in _SILHOUETTE:
+        if not point_in_view(
+            frame, blocked, values, camera, px, py, ptheta, x + k * radius * ax, y + k * radius * ay
+        ):
+            hidden += 1
+    return hidden / _SILHOUETTE.size
+
+
+@njit(cache=True, inline="always")
 def detect(
     frame: np.ndarray,
     blocked: np.ndarray,
     values: np.ndarray,
     camera: np.ndarray,
+    perception: np.ndarray,
     radius: float,
     poses: np.ndarray,
+    draws: np.ndarray,
+    drawn: np.ndarray,
     detected: np.ndarray,
     detection: np.ndarray,
     game: int,
 ) -> bool:
     """The oracle detector's capture for ``game``'s current poses (state.poses) into
-    ``detected`` and ``detection`` (state's; the pipeline's parts all off; ``camera``:
-    rules.camera, ``radius``: the evader's). Returns whether the evader's centre is in
-    view."""
+    ``detected`` and ``detection`` (rows of the game; ``camera``: rules.camera,
+    ``perception``: rules.perception, ``radius``: the evader's; a range or occlusion miss
+    takes the next of the game's ``draws``, counted in ``drawn``). Returns whether the
+    evader's centre is in view."""
     cx, cy, ctheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
     ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
     detected[game] = False
@@ -234,6 +281,22 @@ def detect(
     distance = hypot(ex - cx, ey - cy)
     if not distance <= camera[DETECTION_RANGE]:
         return True
+    if perception[MISSES] != 0.0:
+        hidden = 0.0
+        if perception[OCCLUSION_MISS] > 0.0:
+            hidden = hidden_fraction(frame, blocked, values, camera, cx, cy, ctheta, ex, ey, radius)
+        chance = miss_chance(
+            distance,
+            hidden,
+            camera[DETECTION_RANGE],
+            perception[MISS_START],
+            perception[MISS_AT_RANGE],
+            perception[OCCLUSION_MISS],
+        )
+        draw = draws[game, drawn[game]]
+        drawn[game] += 1
+        if draw < chance:
+            return True
     bearing = wrap_angle(math.atan2(ey - cy, ex - cx) - ctheta)
     depth = distance * math.cos(bearing)
     depth = depth if depth > camera[NEAR] else camera[NEAR]
@@ -265,6 +328,59 @@ def detect(
 
 
 @njit(cache=True, inline="always")
+def _deliver(
+    world: World, rules: Rules, state: BatchState, game: int, time: float, radius: float
+) -> bool:
+    """The perception pipeline's tick of ``game`` at ``time`` s: a capture when a frame is
+    due (into state.capture), put in flight, and the result delivered by then into
+    state.detected and state.detection (the held one stays when none is). Returns whether
+    the evader's centre is in view."""
+    frame, blocked, values = world.frame, world.blocked, world.sight_values
+    camera, perception = rules.camera, rules.perception
+    poses = state.poses
+    period, rated = perception[PERIOD], perception[RATED] != 0.0
+    due, _ = frame_due(state.clock, game, time, period, rated)
+    if due:
+        centre = detect(
+            frame,
+            blocked,
+            values,
+            camera,
+            perception,
+            radius,
+            poses,
+            state.draws,
+            state.drawn,
+            state.captured,
+            state.capture,
+            game,
+        )
+    else:
+        px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
+        ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
+        centre = point_in_view(frame, blocked, values, camera, px, py, ptheta, ex, ey)
+    slot_in, slot_out, _ = deliver_frame(
+        state.clock,
+        state.due,
+        state.head,
+        state.size,
+        game,
+        time,
+        period,
+        rated,
+        perception[LATENCY],
+        due,
+    )
+    if slot_in >= 0:
+        state.in_flight_detected[game, slot_in] = state.captured[game]
+        state.in_flight[game, slot_in, :] = state.capture[game, :]
+    if slot_out >= 0:
+        state.detected[game] = state.in_flight_detected[game, slot_out]
+        state.detection[game, :] = state.in_flight[game, slot_out, :]
+    return centre
+
+
+@njit(cache=True, inline="always")
 def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
     """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
     pursuer observation's memory of the last detection (``PursuerFeatures.remember``).
@@ -273,7 +389,24 @@ def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
     frame, blocked, values = world.frame, world.blocked, world.sight_values
     camera, radius = rules.camera, rules.bodies[EVADER, RADIUS]
     poses, detected, detection = state.poses, state.detected, state.detection
-    centre = detect(frame, blocked, values, camera, radius, poses, detected, detection, game)
+    time = state.steps[game] * rules.control_dt
+    if rules.perception[PIPELINE] != 0.0:
+        centre = _deliver(world, rules, state, game, time, radius)
+    else:
+        centre = detect(
+            frame,
+            blocked,
+            values,
+            camera,
+            rules.perception,
+            radius,
+            poses,
+            state.draws,
+            state.drawn,
+            detected,
+            detection,
+            game,
+        )
     px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
     ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
     state.in_view[game] = body_in_view(
@@ -281,7 +414,7 @@ def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
     )
     if detected[game]:
         seen = state.seen
-        seen[game, 0] = state.steps[game] * rules.control_dt
+        seen[game, 0] = time
         seen[game, 1] = detection[game, SEEN_X]
         seen[game, 2] = detection[game, SEEN_Y]
         state.has_seen[game] = True

@@ -38,9 +38,12 @@ batched version of every plugin interface. The kernels keep the loop's order ins
 and the side-by-side test is the contract.
 
 What the batched game plays (anything else is a ConfigError at construction): the grid
-simulator; the oracle detector with its perception parts off (the default; no misses,
-noise, rate, latency or false positives); ``game.turn_order=simultaneous``; no belief in
-the observation. A pursuer strategy as the opponent adds the loop's estimation per game
+simulator; the oracle detector with the perception model's rate, latency, detection
+range and range and occlusion misses (every setting of ``+experiment=paper_conditions``
+but its turn order; the pipeline and the miss chance are the scalar detector's own
+kernels, :mod:`pegame.detectors.perception`), not its independent or bursty misses,
+noise or false positives; ``game.turn_order=simultaneous``; no belief in the
+observation. A pursuer strategy as the opponent adds the loop's estimation per game
 in Python (:class:`pegame.vector.opponents.PursuerStrategyOpponent`).
 """
 
@@ -54,7 +57,17 @@ from omegaconf import DictConfig
 
 from pegame.api import Context
 from pegame.detectors.oracle import OracleDetector
-from pegame.detectors.perception import detection_range
+from pegame.detectors.perception import (
+    PerceptionConfig,
+    Pipeline,
+    capture_period,
+    detection_range,
+    misses_by_range_or_occlusion,
+    part_generators,
+    pipeline_slots,
+    reset_pipeline,
+    runs_pipeline,
+)
 from pegame.envs.crop import LocalCrop
 from pegame.envs.observations import EvaderFeatures, PursuerFeatures
 from pegame.envs.settings import EnvSettings
@@ -78,14 +91,10 @@ from pegame.vector.state import (
     new_state,
 )
 
-#: the oracle detector's perception fields and the values the kernels play
+#: the oracle detector's perception fields the kernels play only off, and that value
 PERCEPTION_OFF = {
-    "rate": None,
-    "latency": 0.0,
     "miss_probability": 0.0,
     "burst_miss_fraction": 0.0,
-    "miss_range_start": None,
-    "occlusion_miss": 0.0,
     "range_noise": 0.0,
     "range_noise_growth": 0.0,
     "bearing_noise": 0.0,
@@ -148,6 +157,7 @@ class BatchedGame:
         self.num_games = int(num_games)
         self.scenario = scenario = Scenario(cfg)
         check_playable(scenario, settings)
+        self._misses = misses_by_range_or_occlusion(_detector(scenario))
         context = scenario.context
         self.context = context
         self.ticks_per_action = settings.ticks_per_action(context.control_dt)
@@ -157,7 +167,9 @@ class BatchedGame:
         }
         self.world = _world(context.grid, context, settings)
         self.rules = _rules(scenario)
-        self.state: BatchState = new_state(self.num_games)
+        self.state: BatchState = new_state(
+            self.num_games, _slots(scenario), _draws(scenario) if self._misses else 1
+        )
         self.state.tally[:] = new_tally()
         self.opponent = (
             opponent_for(scenario, self.roles[0], self.rules.bodies, self.num_games)
@@ -190,11 +202,17 @@ class BatchedGame:
             state.poses[game, EVADER] = (evader.x, evader.y, evader.theta)
             if opponent is not None:
                 opponent.reset(game, streams, pursuer if opponent.role == PURSUER else evader)
+            if self._misses:  # the detector's 'range' part, drawn ahead
+                rng = part_generators(np.random.default_rng(streams["detector"]))["range"]
+                state.draws[game] = rng.random(state.draws.shape[1])
         state.velocities[games] = 0.0
         state.commands[games] = 0.0
         state.steps[games] = 0
         state.has_seen[games] = False
         state.tally[games] = new_tally()
+        state.detected[games] = False  # nothing delivered yet
+        reset_pipeline(Pipeline(state.clock, state.due, state.head, state.size), games)
+        state.drawn[games] = 0
         kernels.sense_games(self.world, self.rules, state, games)
         if opponent is not None:
             opponent.sensed(state, games, self.context.control_dt)
@@ -244,11 +262,12 @@ class BatchedGame:
 
     def summary(self, game: int) -> dict:
         """Game ``game``'s measures (``TrackingMetrics.summary``): a pursuer strategy's
-        opponent keeps them itself (with the estimator's), else the kernels' tally."""
+        opponent keeps them itself (with the estimator's), else the kernels' tally. The
+        batched game keeps no loss causes (:mod:`pegame.losses`): ``loss_causes`` is None."""
         metrics = getattr(self.opponent, "metrics", None)
         if metrics is not None:
-            return metrics[game].summary()
-        return summary(self.state.tally[game], self.context.control_dt)
+            return {**metrics[game].summary(), "loss_causes": None}
+        return {**summary(self.state.tally[game], self.context.control_dt), "loss_causes": None}
 
 
 _NO_TABLE = np.zeros((1, 1, 2))
@@ -273,6 +292,45 @@ def _world(grid: OccupancyGrid, context: Context, settings: EnvSettings) -> Worl
         crop._lattice.centres,
         np.concatenate([[True], grid.blocked.ravel()]),
         np.array([x0, y0, 2.0 / (x1 - x0), 2.0 / (y1 - y0), math.hypot(x1 - x0, y1 - y0)]),
+    )
+
+
+def _detector(scenario: Scenario) -> PerceptionConfig:
+    config = scenario.configs["detector"]
+    assert isinstance(config, PerceptionConfig)  # check_playable: the oracle's
+    return config
+
+
+def _slots(scenario: Scenario) -> int:
+    """The results in flight a game's pipeline holds at most."""
+    config = _detector(scenario)
+    return pipeline_slots(config.latency, capture_period(config, scenario.context.control_dt))
+
+
+def _draws(scenario: Scenario) -> int:
+    """The most range-stream draws of a game: one per capture, at most one per tick (and
+    tick 0) and one per capture period."""
+    config, ticks = _detector(scenario), scenario.settings.ticks
+    period = capture_period(config, scenario.context.control_dt)
+    frames = math.floor(ticks * scenario.context.control_dt / period) + 2
+    return min(ticks + 1, frames)
+
+
+def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
+    """rules.perception (PERIOD..OCCLUSION_MISS) of the detector's ``config``."""
+    start = math.nan if config.miss_range_start is None else config.miss_range_start
+    return np.array(
+        [
+            capture_period(config, control_dt),
+            float(config.rate is not None),
+            config.latency,
+            float(runs_pipeline(config)),
+            float(misses_by_range_or_occlusion(config)),
+            start,
+            config.miss_at_range,
+            config.occlusion_miss,
+        ],
+        dtype=np.float64,
     )
 
 
@@ -303,6 +361,7 @@ def _rules(scenario: Scenario) -> Rules:
     return Rules(
         bodies,
         numbers,
+        _perception(detector, float(context.control_dt)),
         float(context.control_dt),
         int(settings.substeps),
         int(settings.decide_every),

@@ -18,8 +18,15 @@ RADIUS, V_MAX, W_MAX, A_MAX, ALPHA_MAX = range(5)
 FOV, NEAR, FAR, IMAGE_WIDTH, IMAGE_HEIGHT, FOCAL, DETECTION_RANGE, BODY_HEIGHT, CAMERA_HEIGHT = (
     range(9)
 )
+#: entries of ``rules.perception`` (the perception model's parts the batched game plays,
+#: :mod:`pegame.detectors.perception`): the capture period (s), whether a rate sets it,
+#: the latency (s), whether the pipeline runs (else each tick delivers its own capture),
+#: whether the range or occlusion miss is on, miss_range_start (m, NaN: off),
+#: miss_at_range, occlusion_miss
+PERIOD, RATED, LATENCY, PIPELINE, MISSES, MISS_START, MISS_AT_RANGE, OCCLUSION_MISS = range(8)
 #: columns of ``state.detection``: the box (px), the depth (m) and the map position (m)
 BOX_X, BOX_Y, BOX_W, BOX_H, DEPTH, SEEN_X, SEEN_Y = range(7)
+DETECTION_SIZE = 7
 #: columns of ``state.tally`` (counts are exact in float64)
 (
     TICKS,
@@ -81,12 +88,14 @@ class Rules(NamedTuple):
 
     bodies: (2, 5) float64 per role (pursuer, evader): radius (m), v_max (m/s), w_max
     (rad/s), a_max (m/s^2), alpha_max (rad/s^2); camera: float64 (9,) as the constants
-    FOV..CAMERA_HEIGHT; control_dt (s); substeps per control tick; decide_every: control
+    FOV..CAMERA_HEIGHT; perception: float64 (8,) as the constants PERIOD..OCCLUSION_MISS;
+    control_dt (s); substeps per control tick; decide_every: control
     ticks per decision; ticks: control ticks per game.
     """
 
     bodies: np.ndarray
     camera: np.ndarray
+    perception: np.ndarray
     control_dt: float
     substeps: int
     decide_every: int
@@ -103,6 +112,12 @@ class BatchState(NamedTuple):
     seen (N, 3): time (s) and position of the last detection, for the pursuer's
     observation, with has_seen (N,); tally (N, TALLY_SIZE): the metrics' running sums;
     rewards (N,): detections counted in the current env step.
+
+    The perception pipeline, when it runs (delivered: detected and detection): clock,
+    due, head, size: its :class:`pegame.detectors.perception.Pipeline`, K slots; captured
+    (N,) and capture (N, 7): the tick's own capture; in_flight_detected (N, K) and
+    in_flight (N, K, 7): the results in flight by slot; draws (N, D): each game's range
+    stream drawn ahead (the range and occlusion misses), drawn (N,) of them used.
     """
 
     poses: np.ndarray
@@ -116,10 +131,21 @@ class BatchState(NamedTuple):
     has_seen: np.ndarray
     tally: np.ndarray
     rewards: np.ndarray
+    clock: np.ndarray
+    due: np.ndarray
+    head: np.ndarray
+    size: np.ndarray
+    captured: np.ndarray
+    capture: np.ndarray
+    in_flight_detected: np.ndarray
+    in_flight: np.ndarray
+    draws: np.ndarray
+    drawn: np.ndarray
 
 
-def new_state(num_games: int) -> BatchState:
-    """Zeroed state for ``num_games`` games."""
+def new_state(num_games: int, slots: int = 1, draws: int = 1) -> BatchState:
+    """Zeroed state for ``num_games`` games, ``slots`` results in flight and ``draws``
+    random numbers per game."""
     n = num_games
     return BatchState(
         np.zeros((n, 2, 3)),
@@ -127,10 +153,20 @@ def new_state(num_games: int) -> BatchState:
         np.zeros((n, 2, 2)),
         np.zeros(n, np.int64),
         np.zeros(n, np.bool_),
-        np.zeros((n, 7)),
+        np.zeros((n, DETECTION_SIZE)),
         np.zeros(n, np.bool_),
         np.zeros((n, 3)),
         np.zeros(n, np.bool_),
         np.zeros((n, TALLY_SIZE)),
         np.zeros(n),
+        np.zeros((n, 3)),
+        np.zeros((n, slots)),
+        np.zeros(n, np.int64),
+        np.zeros(n, np.int64),
+        np.zeros(n, np.bool_),
+        np.zeros((n, DETECTION_SIZE)),
+        np.zeros((n, slots), np.bool_),
+        np.zeros((n, slots, DETECTION_SIZE)),
+        np.zeros((n, draws)),
+        np.zeros(n, np.int64),
     )
