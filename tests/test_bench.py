@@ -36,6 +36,9 @@ def test_report_text_shows_missing_figures_as_dashes():
                 "pybullet_rtf",
                 "vision_precision",
                 "vision_recall",
+                "person_precision",
+                "person_recall",
+                "person_latency_ms",
             )
         )
     )
