@@ -14,7 +14,7 @@ HTML comments are not prose).
 Sources:
 
 - ``docs/paper_table1/``: the default sweep's Table 1 (``table1.csv``: mean tracking rate
-  with its 95% bootstrap CI) and its hypotheses (``report.json``);
+  with its 95% bootstrap CI), its hypotheses and the paper's trends (``report.json``);
 - ``docs/paper_conditions/``: the paper's values (``paper_table1.csv``, from its .tex),
   the distance of each table from them (``vs_paper.csv``), the one-factor ablations
   (``factor_table.csv``), Table 1 of the 3D pipeline (``table1_3d/table1.csv``) and the
@@ -147,6 +147,24 @@ def h3_example() -> str:
     return f"{percent(row['x_stats']['mean'])}% against {percent(row['y_stats']['mean'])}%"
 
 
+def trend(name: str, study: str = "paper_table1") -> dict:
+    return next(t for t in report(f"{study}/report.json")["trends"] if t["id"] == name)
+
+
+def rises(pairing: str, study: str = "paper_table1", paired: bool = False) -> str:
+    """'N of M' environments where T1 (tracking rises with v_p/v_e; Jonckheere-Terpstra,
+    or with ``paired`` Page's L on common seeds) holds for ``pairing``, of those tested."""
+    tests = [r["paired"] if paired else r for r in trend("T1", study)["rows"] if r["pairing"] == pairing]
+    tested = [t for t in tests if t["holds"] is not None]
+    return f"{sum(t['holds'] for t in tested)} of {len(tested)}"
+
+
+def trend_cells(name: str, study: str = "paper_table1", paired: bool = False) -> str:
+    """'N of M' rows where trend ``name`` holds (the report's verdict, or the paired one)."""
+    summary = trend(name, study)["summary_paired" if paired else "summary"]
+    return f"{summary['k']} of {summary['n']}"
+
+
 def h3_reasonable() -> str:
     tested = hypothesis("H3")["rows"]
     return f"{sum(r['reasonable'] for r in tested)} of {len(tested)}"
@@ -220,6 +238,12 @@ PAPER_TABLE1_VALUES: dict[str, Callable[[], str]] = {
     "h3_threshold": lambda: percent(REASONABLE_RATE, 0),
     "h3_example": h3_example,
     "h3_reasonable": h3_reasonable,
+    "t1_sr": lambda: rises("S-R"),
+    "t1_ss": lambda: rises("S-S"),
+    "t1_rr": lambda: rises("R-R"),
+    "t1_paired": lambda: trend_cells("T1", paired=True),
+    "t1_rows": lambda: trend_cells("T1"),
+    "t2_cells": lambda: trend_cells("T2"),
     "distance_defaults": lambda: mean_distance("defaults"),
     "distance_conditions": lambda: mean_distance("paper_conditions"),
     "inside_defaults": lambda: inside_ci("defaults"),

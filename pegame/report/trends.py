@@ -21,6 +21,7 @@ A sweep with other factors is tested per combination of them, like H1-H3.
 
 from __future__ import annotations
 
+from decimal import ROUND_HALF_UP, Decimal
 from typing import Any
 
 from pegame.report.cells import MAP_ORDER, PAIRING_ORDER, ordered
@@ -148,11 +149,20 @@ def trends(rates: Rates, seeded: Seeded | None = None) -> list[dict[str, Any]]:
     return [rises_with_speed(rates, seeded), evader_harder(rates, seeded)]
 
 
-def path_text(values: list[float] | None) -> str:
-    """'38.1 → 47.0 → 36.2%' ('–' for None)."""
+def path_text(values: list[float] | None, halves_up: bool = False) -> str:
+    """'38.1 → 47.0 → 36.2%' ('–' for None); with ``halves_up`` the decimal halves of the
+    values as written round up (the paper's 23.85% is 23.9, which a binary float prints as
+    23.8)."""
     if values is None:
         return "–"
-    return ARROW.join(f"{100 * v:.1f}" for v in values) + "%"
+    if halves_up:
+        texts = [
+            str((Decimal(str(v)) * 100).quantize(Decimal("0.1"), rounding=ROUND_HALF_UP))
+            for v in values
+        ]
+    else:
+        texts = [f"{100 * v:.1f}" for v in values]
+    return ARROW.join(texts) + "%"
 
 
 def render_rise(t: dict[str, Any]) -> list[str]:
@@ -166,7 +176,7 @@ def render_rise(t: dict[str, Any]) -> list[str]:
         *place,
         ("n", lambda r: ", ".join(map(str, r["n"]))),
         ("mean", lambda r: path_text(r["means"])),
-        ("paper", lambda r: path_text(r["paper_means"])),
+        ("paper", lambda r: path_text(r["paper_means"], halves_up=True)),
         ("J", lambda r: number_text(r["J"], "g")),
         ("tau", lambda r: number_text(r["tau"], "+.2f")),
         ("z", lambda r: number_text(r["z"], "+.2f")),

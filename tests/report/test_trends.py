@@ -49,6 +49,7 @@ def test_a_rise_holds_a_fall_and_a_flat_line_do_not(tmp_path):
     md = (tmp_path / "out" / "hypotheses.md").read_text()
     assert "# The paper's trends" in md and "## T1: partly (in 2 of 6 cells)" in md
     assert "55.1 → 78.5 → 84.8%" in md  # the paper's hall S-R beside ours
+    assert "21.8 → 23.9 → 17.6%" in md  # its 23.85%, halves up as the paper prints it
 
 
 def test_holm_corrects_across_the_rows_and_one_ratio_is_untested():
