@@ -6,7 +6,8 @@ machine. Numba kernels are compiled (or loaded from cache) by a warm-up call fir
 first-call cost is reported separately as ``jit_warmup_s``. Keys whose piece does not exist
 yet are null. Figures taken on each paper map are under ``maps``; the top-level key is the
 worst map's (the most ms, the fewest S-S games per second). ``team_game_s`` is the cost of
-a game by team size (N pursuers v M evaders).
+a game by team size (N pursuers v M evaders). ``loss_causes_overhead`` is the extra time a
+game's ticks take to follow its losses of track and their causes (:mod:`pegame.losses`).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import resource
 import statistics
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -32,8 +33,9 @@ from pegame.bench_maps import SIZES, format_rows, map_scaling
 from pegame.config import compose, resolve_map_path
 from pegame.game import Game
 from pegame.grid import OccupancyGrid, load_map
+from pegame.losses import Loss, LossCauses
 from pegame.navigation import Planner
-from pegame.types import Belief, Body, Camera, Plan, Pose
+from pegame.types import Belief, Body, Camera, Detection, Plan, Pose, Velocity
 from pegame.visibility import MaskRegion, VisibilityRegion, visibility_region
 
 PAPER_MAPS = ("hall", "enclosed", "brick")
@@ -225,6 +227,95 @@ def recorder_cost(games: int, out_dir: str) -> tuple[float | None, float | None]
     return statistics.median(ratios), (max(sizes) / 2**20 if sizes else None)
 
 
+class _NoLosses(LossCauses):
+    """Loss causes that follow nothing: a game's loop without them, for
+    :func:`loss_causes_cost`."""
+
+    def add_one(
+        self, pursuer: Pose, evader: Pose, detected: bool, command: Velocity
+    ) -> tuple[Loss, ...]:
+        return ()
+
+    def add(
+        self,
+        pursuers: Sequence[Pose],
+        evaders: Sequence[Pose],
+        detections: Sequence[Sequence[Detection | None]],
+        commands: Sequence[Velocity],
+    ) -> tuple[Loss, ...]:
+        return ()
+
+
+class _TimedLosses(LossCauses):
+    """Loss causes that also add up the wall time (s) spent in them, ``seconds``."""
+
+    seconds = 0.0
+
+    def add_one(
+        self, pursuer: Pose, evader: Pose, detected: bool, command: Velocity
+    ) -> tuple[Loss, ...]:
+        start = time.perf_counter()
+        losses = super().add_one(pursuer, evader, detected, command)
+        self.seconds += time.perf_counter() - start
+        return losses
+
+    def add(
+        self,
+        pursuers: Sequence[Pose],
+        evaders: Sequence[Pose],
+        detections: Sequence[Sequence[Detection | None]],
+        commands: Sequence[Velocity],
+    ) -> tuple[Loss, ...]:
+        start = time.perf_counter()
+        losses = super().add(pursuers, evaders, detections, commands)
+        self.seconds += time.perf_counter() - start
+        return losses
+
+
+def ticks_seconds(overrides: list[str], kind: type[LossCauses]) -> tuple[float, LossCauses]:
+    """(CPU time (s) of playing every tick of one game, no recorder and no files; the
+    game's loss causes), its losses followed by a ``kind``."""
+    loop = Game(compose(["recorder=none", *overrides])).start()
+    loop.losses = loop.metrics.losses = kind(loop.context, loop.n_pursuers, loop.n_evaders)
+    start = time.process_time()
+    while not loop.done:
+        loop.advance()
+    return time.process_time() - start, loop.losses
+
+
+#: the games whose loss-cause cost the bench reports: the default S-S game, and R-R, the
+#: cheapest tick with the most losses
+LOSS_GAMES = {
+    "S-S": ["pursuer=smart", "evader=smart", "env=enclosed"],
+    "R-R": ["pursuer=random", "evader=random", "env=enclosed"],
+}
+
+
+def loss_causes_cost(games: int, t_max: float = 90.0) -> dict[str, dict[str, float]]:
+    """Per pairing of :data:`LOSS_GAMES`, a game's fractional extra time for following its
+    losses of track and their causes, two ways, each the median over ``games`` seeds
+    after a warm-up game: ``paired``, the CPU time of its ticks with them over that
+    without them, minus 1 (each seed played both ways one right after the other, in
+    alternating order, so that neighbouring runs see the same load); ``inside``, in a
+    third run, the wall time spent in :class:`pegame.losses.LossCauses` over the rest of
+    the game's ticks (timed call by call: an upper bound, the timer's own cost included,
+    and far less noisy than the difference of two games)."""
+    cost = {}
+    for pairing, overrides in LOSS_GAMES.items():
+        ticks_seconds([*overrides, f"game.t_max={min(t_max, 5.0)}"], LossCauses)  # warm-up
+        paired, inside = [], []
+        for seed in range(games):
+            game = [*overrides, f"game.seed={seed}", f"game.t_max={t_max}"]
+            order = (_NoLosses, LossCauses) if seed % 2 == 0 else (LossCauses, _NoLosses)
+            runs = {kind: ticks_seconds(game, kind)[0] for kind in order}
+            paired.append(runs[LossCauses] / runs[_NoLosses] - 1.0)
+            played, timed = ticks_seconds(game, _TimedLosses)
+            assert isinstance(timed, _TimedLosses)  # the run of that kind
+            inside.append(timed.seconds / (played - timed.seconds))
+        cost[pairing] = {"paired": statistics.median(paired), "inside": statistics.median(inside)}
+    return cost
+
+
 def env_steps_per_second(seconds: float) -> float | None:
     """PettingZoo env steps per second with random actions (null without pettingzoo)."""
     try:
@@ -321,6 +412,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             row["ss_games_per_s"] = games_per_second(ss, games, tmp) if smart else None
         report["recorder_overhead"], report["rrd_mb_per_game"] = recorder_cost(3 * games, tmp)
         report["team_game_s"] = team_scaling(games, tmp, 30.0 if args.quick else 90.0)
+    report["loss_causes_overhead"] = loss_causes_cost(3 * games)
     for key in ("visibility_ms", "distance_field_ms", "plan_ms", "pf_step_ms"):
         values = [m[key] for m in per_map.values() if m.get(key) is not None]
         report[key] = max(values) if values else None  # the worst paper map
@@ -381,6 +473,13 @@ def format_report(report: dict[str, Any]) -> str:
         f"recorder: +{fmt(None if overhead is None else 100 * overhead)}% game time, "
         f"{fmt(report['rrd_mb_per_game'])} MB per 90 s game"
     )
+    losses = report.get("loss_causes_overhead") or {}
+    if losses:
+        costs = ", ".join(
+            f"{k} +{100 * v['inside']:.2f}% (paired games {100 * v['paired']:+.1f}%)"
+            for k, v in losses.items()
+        )
+        lines.append(f"loss causes, extra game time (median, enclosed): {costs}")
     teams = report.get("team_game_s") or {}
     if teams:
         one = teams.get("1v1") or 1.0

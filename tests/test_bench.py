@@ -52,3 +52,13 @@ def test_team_scaling_times_a_game_of_every_team_size(tmp_path):
     seconds = team_scaling(1, str(tmp_path), t_max=1.0)
     assert list(seconds) == [f"{n}v{m}" for n, m in TEAM_SIZES]
     assert all(value > 0 for value in seconds.values())
+
+
+def test_the_loss_causes_cost_is_measured_on_paired_games_and_inside_the_tracker():
+    from pegame.bench import LOSS_GAMES, loss_causes_cost
+
+    cost = loss_causes_cost(1, t_max=1.0)
+    assert list(cost) == list(LOSS_GAMES)
+    for figures in cost.values():
+        assert set(figures) == {"paired", "inside"}
+        assert math.isfinite(figures["paired"]) and figures["inside"] > 0
