@@ -91,12 +91,33 @@ def _vector_steps_per_second(
     return actions.shape[0] * env.num_envs / (time.perf_counter() - start)
 
 
-def _decision_periods(env: PursuitVectorEnv | EvasionVectorEnv) -> int:
-    """The fewest env steps of ``env`` that hold whole decision periods of its opponent:
-    lcm(decide_every, ticks per step) control ticks."""
-    game = env.game
-    ticks = math.lcm(game.rules.decide_every, game.ticks_per_action)
-    return ticks // game.ticks_per_action
+#: the paper's conditions as a batched env plays them (no env plays the paper's turns)
+PAPER_CONDITIONS = ("+experiment=paper_conditions", "game.turn_order=simultaneous")
+
+
+class _DecisionPeriods:
+    """Rounds of a batched env against a strategy opponent, each of the fewest env steps
+    that hold whole decision periods of the opponent (lcm(decide_every, ticks per step)
+    control ticks), a game that would end inside one reset first, untimed; ``env`` is
+    reset with ``seed`` and stepped once (its opponent's first calls, untimed)."""
+
+    def __init__(self, env: PursuitVectorEnv | EvasionVectorEnv, seed: int) -> None:
+        game = env.game
+        env.reset(seed=seed)
+        env.step(np.zeros((env.num_envs, 2), np.float32))  # the opponent's first calls
+        self.env, self.seed, self.games, self.played = env, seed, 1, 1
+        self.steps = math.lcm(game.rules.decide_every, game.ticks_per_action)
+        self.steps //= game.ticks_per_action
+
+    def steps_per_second(self, rng: np.random.Generator) -> float:
+        """One round's env steps (games x batched steps) per second, on one thread."""
+        env = self.env
+        if self.played + self.steps >= env.game.steps:
+            env.reset(seed=self.seed + self.games * env.num_envs)
+            self.played, self.games = 0, self.games + 1
+        actions = rng.uniform(-1.0, 1.0, (self.steps, env.num_envs, 2)).astype(np.float32)
+        self.played += self.steps
+        return _vector_steps_per_second(env, actions, 1)
 
 
 def bench_vector_env(
@@ -116,10 +137,11 @@ def bench_vector_env(
     batched pursuer env of ``num_envs`` games against the random evader with
     ``model=action`` on one numba thread (the per-core figure, as NUMBA_NUM_THREADS=1)
     and on all of numba's threads, and the batched env of ``smart_envs`` games against
-    the smart evader over whole decision periods (the env steps holding a whole number of
-    the evader's decision intervals: 10 at the defaults, the smart evader deciding every
-    10th tick; a shorter round mostly holds no decision and overstates the rate; a game
-    that would end inside a round is reset first, untimed). Resets are not timed (a reset
+    the smart evader, under the default and under the paper's conditions
+    (:data:`PAPER_CONDITIONS`), over whole decision periods (the env steps holding a whole
+    number of the evader's decision intervals: 10 at the defaults, the smart evader
+    deciding every 10th tick; a shorter round mostly holds no decision and overstates the
+    rate; a game that would end inside a round is reset first, untimed). Resets are not timed (a reset
     spawns each game in Python: its cost per game is ``vector_reset_ms_per_game``).
     Figures are medians over the rounds; ``vector_speedup_per_core`` is the median of the
     rounds' ratios to the single env.
@@ -153,12 +175,17 @@ def bench_vector_env(
     env.step(np.zeros((num_envs, 2), np.float32))
     memory = (_rss_bytes() - before) / num_envs
     arrays = _array_bytes(env) / num_envs
-    smart = vector_env(smart_envs, overrides=overrides, opponent="smart", **settings)
-    smart.reset(seed=seed)
-    smart.step(np.zeros((smart_envs, 2), np.float32))
-    smart_round = _decision_periods(smart)
-    smart_played, smart_games = 1, 1
-    per_round: dict[str, list[float]] = {"single": [], "core": [], "all": [], "smart": []}
+    smart = {
+        key: _DecisionPeriods(
+            vector_env(smart_envs, overrides=options, opponent="smart", **settings), seed
+        )
+        for key, options in (
+            ("smart", overrides),
+            ("smart_paper", [*overrides, *PAPER_CONDITIONS]),
+        )
+    }
+    per_round: dict[str, list[float]] = {"single": [], "core": [], "all": []}
+    per_round.update({key: [] for key in smart})
     batch = 4
     played = 1
     deadline = time.perf_counter() + seconds
@@ -172,12 +199,8 @@ def bench_vector_env(
         actions = rng.uniform(-1.0, 1.0, (batch, num_envs, 2)).astype(np.float32)
         per_round["core"].append(_vector_steps_per_second(env, actions, 1))
         per_round["all"].append(_vector_steps_per_second(env, actions, threads))
-        if smart_played + smart_round >= smart.game.steps:
-            smart.reset(seed=seed + smart_games * smart_envs)
-            smart_played, smart_games = 0, smart_games + 1
-        actions = rng.uniform(-1.0, 1.0, (smart_round, smart_envs, 2)).astype(np.float32)
-        per_round["smart"].append(_vector_steps_per_second(smart, actions, 1))
-        smart_played += smart_round
+        for key, periods in smart.items():
+            per_round[key].append(periods.steps_per_second(rng))
         played += 3 * batch
     numba.set_num_threads(threads)
     single.close()
@@ -196,6 +219,7 @@ def bench_vector_env(
         "vector_env_array_bytes_per_game": arrays,
         "num_envs_smart": smart_envs,
         "vector_env_steps_per_s_smart": median["smart"],
+        "vector_env_steps_per_s_smart_paper": median["smart_paper"],
         "smart_opponent_us_per_game_step": 1e6 / median["smart"] - 1e6 / median["core"],
     }
 
@@ -224,5 +248,6 @@ def format_vector(report: dict) -> str:
         f"({r['vector_env_array_bytes_per_game'] / 1024:.1f} KiB of arrays), reset "
         f"{r['vector_reset_ms_per_game']:.2f} ms per game; smart evader "
         f"({r['num_envs_smart']} games): {r['vector_env_steps_per_s_smart']:.0f} steps/s, "
-        f"+{r['smart_opponent_us_per_game_step']:.1f} us per game step"
+        f"+{r['smart_opponent_us_per_game_step']:.1f} us per game step, under the paper's "
+        f"conditions {r['vector_env_steps_per_s_smart_paper']:.0f} steps/s"
     )

@@ -21,6 +21,7 @@ def test_vector_bench_measures_every_figure_in_alternating_rounds():
         "vector_env_steps_per_s",
         "vector_env_steps_per_s_all_cores",
         "vector_env_steps_per_s_smart",
+        "vector_env_steps_per_s_smart_paper",
         "vector_reset_ms_per_game",
         "vector_env_array_bytes_per_game",
     ):
