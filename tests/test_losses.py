@@ -149,15 +149,27 @@ def _transitions(flags: list[bool]) -> int:
     return sum(a and not b for a, b in zip(flags, flags[1:]))
 
 
+RR = ["pursuer=random", "evader=random"]
+
+
 @pytest.mark.parametrize(
     "overrides",
     [
-        ["pursuer=random", "evader=random", "env=brick"],
-        ["pursuer=smart", "evader=smart", "env=hall", "detector.miss_probability=0.2"],
+        [*RR, "env=brick", "game.seed=3", "game.t_max=40"],
+        ["env=hall", "detector.miss_probability=0.2", "game.seed=3", "game.t_max=40"],
+        # the 3D plugins' detectors, on the images of sim=pybullet
+        *(
+            pytest.param(
+                [*RR, "sim=pybullet", f"detector={name}", "game.seed=0", "game.t_max=15"],
+                marks=pytest.mark.slow,
+                id=name,
+            )
+            for name in ("segmentation", "vision")
+        ),
     ],
 )
 def test_a_games_losses_count_every_loss_once_and_its_time_lost(overrides):
-    game = Game(compose(["recorder=none", "game.t_max=40", "game.seed=3", *overrides]))
+    game = Game(compose(["recorder=none", *overrides]))
     loop = game.start()
     ticks = [loop.advance() for _ in range(loop.ticks)]
     detected = [tick.detection is not None for tick in ticks]
