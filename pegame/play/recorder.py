@@ -65,7 +65,7 @@ def frame(tick: Tick, show: tuple[str, ...]) -> dict[str, Any]:
         if belief.mean is not None:
             shown["mean"] = [float(v) for v in belief.mean]
         if belief.particles is not None and len(belief.particles):
-            step = max(1, len(belief.particles) // MAX_PARTICLES)
+            step = -(-len(belief.particles) // MAX_PARTICLES)  # ceil: at most MAX_PARTICLES
             shown["particles"] = np.round(belief.particles[::step, :2], 3).tolist()
         out["belief"] = shown
     out["sent"] = now_ms()

@@ -85,6 +85,14 @@ function start() {
 
 // -- drawing: one pixel scale for the map, world (x, y) m -> canvas px
 
+// The canvas sized to the map's shape, as large as the window leaves room for.
+function fitCanvas(map) {
+  const room = [Math.max(window.innerWidth - 360, 200), Math.max(window.innerHeight - 90, 150)];
+  const scale = Math.min(room[0] / map.width, room[1] / map.height);
+  canvas.width = Math.round(map.width * scale);
+  canvas.height = Math.round(map.height * scale);
+}
+
 function layout() {
   const map = pegame.game.map;
   const scale = Math.min(canvas.width / map.width, canvas.height / map.height);
@@ -179,6 +187,7 @@ function onMessage(event) {
   if (message.type === "game") {
     pegame.game = message;
     pegame.result = null;
+    fitCanvas(message.map);
     mapImage = new Image();
     mapImage.src = message.map.image;
     sentCommand = { v: 0, w: 0 };
