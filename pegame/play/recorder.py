@@ -37,7 +37,7 @@ def map_message(grid: OccupancyGrid) -> dict[str, Any]:
     resolution (m) and the origin (x m, y m) of cell (0, 0)'s lower-left corner."""
     shades = np.where(grid.blocked, 60, 255).astype(np.uint8)[::-1]
     buffer = io.BytesIO()
-    Image.fromarray(shades, mode="L").save(buffer, format="PNG")
+    Image.fromarray(shades).save(buffer, format="PNG")  # uint8 (H, W): greyscale
     return {
         "name": grid.name,
         "width": grid.width,
