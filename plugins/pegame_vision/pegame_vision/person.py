@@ -11,7 +11,9 @@ the main modules to contrib's ``xobjdetect``, hence the ``opencv-contrib-python-
 dependency (4.x builds have it in ``objdetect``). A person must stand about as tall in the
 image as the window's person (~96 px for INRIA, ~72 px for Daimler) or taller; the image
 is searched at scales ``scale``, ``scale``^2, ... and the window with the highest SVM
-score above ``hit_threshold`` is the person.
+score above ``hit_threshold`` is the person. A camera 0.4 m above the floor cuts a close
+person's head off at the image's top; ``top_margin`` rows repeating the top row are added
+above the image, so that a window may reach past it.
 
 A HOG window is larger than the person in it (the training windows have a margin), so the
 person's pixels are taken from the depth image: the median depth of the window's core
@@ -56,6 +58,7 @@ class PersonDetector(TrackingDetector):
         depth_tolerance: float = 0.4  # m: the person's pixels are this close to its depth
         min_height: float = 0.05  # m above the floor below which a pixel is floor
         min_pixels: int = 12  # person pixels a detection needs
+        top_margin: int = 64  # px of the top row repeated above the image (module docstring)
 
         def __post_init__(self) -> None:
             super().__post_init__()
@@ -67,6 +70,9 @@ class PersonDetector(TrackingDetector):
             for key in ("depth_tolerance", "min_height"):
                 require(getattr(self, key) > 0, key, "a distance > 0 m", getattr(self, key))
             require(self.min_pixels >= 1, "min_pixels", "a whole number >= 1", self.min_pixels)
+            require(
+                self.top_margin >= 0, "top_margin", "a whole number of px >= 0", self.top_margin
+            )
 
     def __init__(self, config: Config, context: Context, rng: np.random.Generator) -> None:
         window, coefficients = MODELS[config.model]
@@ -84,10 +90,12 @@ class PersonDetector(TrackingDetector):
         (H, W) uint8, and their scores (N,)."""
         cfg = self.config
         stride = (cfg.win_stride, cfg.win_stride)
+        padded = cv2.copyMakeBorder(gray, cfg.top_margin, 0, 0, 0, cv2.BORDER_REPLICATE)
         rects, scores = self.hog.detectMultiScale(
-            gray, hitThreshold=cfg.hit_threshold, winStride=stride, scale=cfg.scale
+            padded, hitThreshold=cfg.hit_threshold, winStride=stride, scale=cfg.scale
         )
-        return np.reshape(rects, (-1, 4)), np.ravel(scores)
+        rects = np.reshape(rects, (-1, 4)) - [0, cfg.top_margin, 0, 0]
+        return rects, np.ravel(scores)
 
     def _find(self, images: RGBD, gray: np.ndarray) -> tuple[Box, np.ndarray] | None:
         rects, scores = self.windows(gray)
