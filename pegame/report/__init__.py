@@ -445,6 +445,8 @@ def main(argv: list[str] | None = None) -> int:
         )
     if "estimation" in report:
         print("the estimator's error while unseen, N_eff and resamplings per cell -> estimation.md")
+    if "loss_causes" in report:
+        print("why tracks are lost, the loss causes per cell -> losses.md, loss_causes.png")
     for s in report.get("vs_paper", {}).get("summaries", []):
         where = f" ({facet_text(s['factors'])})" if s["factors"] else ""
         print(

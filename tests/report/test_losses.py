@@ -103,7 +103,7 @@ def test_no_game_with_loss_causes_writes_no_loss_files(tmp_path):
 
 def test_a_played_games_loss_causes_reach_the_table(tmp_path):
     result = (
-        Game(compose(["recorder=none", "game.t_max=30", "pursuer=random", "evader=random"]))
+        Game(compose(["recorder=none", "game.t_max=20", "pursuer=random", "evader=random"]))
         .play(tmp_path)
         .result
     )
@@ -113,3 +113,10 @@ def test_a_played_games_loss_causes_reach_the_table(tmp_path):
     assert row["losses_per_game"] == sum(c["count"] for c in played.values()) > 0
     for cause in CAUSES:
         assert row[cause]["time_lost_per_game_s"] == played[cause]["time_lost_s"]
+
+
+def test_the_command_line_names_the_loss_files(tmp_path, capsys):
+    write_job(tmp_path / "sweep", "0", GAMES)
+    assert report.main([str(tmp_path / "sweep"), "--out", str(tmp_path / "out")]) == 0
+    assert "the loss causes per cell -> losses.md, loss_causes.png" in capsys.readouterr().out
+    assert (tmp_path / "out" / "loss_causes.svg").is_file()
