@@ -155,7 +155,12 @@ def play_one(
 def latency_line(summary: dict[str, dict[str, float | int | None]]) -> str:
     """One line of a game's measured latencies (ms)."""
     parts = []
-    for name, label in (("key_to_command", "key->command"), ("tick_to_frame", "tick->frame")):
+    labels = (
+        ("key_to_command", "key->command"),
+        ("key_to_server", "key->server"),
+        ("tick_to_frame", "tick->frame"),
+    )
+    for name, label in labels:
         s = summary[name]
         parts.append(
             f"{label} median {s['median']} ms, p95 {s['p95']} ms (n={s['count']})"

@@ -38,20 +38,21 @@ def now_ms() -> float:
 @dataclass
 class Latencies:
     """Measured latencies (ms): ``key_to_command``, from the page's key or gamepad event
-    to the control tick that first applies it; ``tick_to_frame``, from a tick handed to
+    to the control tick that first applies it (it includes the wait for that tick, up to
+    one control period); ``key_to_server``, from the event to its command reaching the
+    session (the page and the network alone); ``tick_to_frame``, from a tick handed to
     the recorder to the page drawing it; ``tick_lag``, by how much each control tick came
     after its wall-clock time (0 when on time)."""
 
     key_to_command: list[float] = field(default_factory=list)
+    key_to_server: list[float] = field(default_factory=list)
     tick_to_frame: list[float] = field(default_factory=list)
     tick_lag: list[float] = field(default_factory=list)
 
     def summary(self) -> dict[str, dict[str, float | int | None]]:
         """For each kind: the count, median, 95th percentile and maximum (ms)."""
-        return {
-            name: _stats(getattr(self, name))
-            for name in ("key_to_command", "tick_to_frame", "tick_lag")
-        }
+        kinds = ("key_to_command", "key_to_server", "tick_to_frame", "tick_lag")
+        return {name: _stats(getattr(self, name)) for name in kinds}
 
 
 def _stats(samples: Sequence[float]) -> dict[str, float | int | None]:
@@ -114,6 +115,8 @@ class Session:
         with self._lock:
             self._command = Velocity(float(v), float(w))
             self._stamp = stamp
+            if stamp is not None:
+                self.latencies.key_to_server.append(now_ms() - stamp)
 
     def frame_drawn(self, sent: float, drawn: float) -> None:
         """The page drew the frame published at ``sent`` at ``drawn`` (both ms)."""
