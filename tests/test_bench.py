@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from pegame.bench import bench_decisions, format_report, machine
 from pegame.config import resolve_map_path
 from pegame.grid import load_map
@@ -54,6 +56,7 @@ def test_team_scaling_times_a_game_of_every_team_size(tmp_path):
     assert all(value > 0 for value in seconds.values())
 
 
+@pytest.mark.slow  # eight short games
 def test_the_loss_causes_cost_is_measured_on_paired_games_and_inside_the_tracker():
     from pegame.bench import LOSS_GAMES, loss_causes_cost
 
