@@ -8,8 +8,8 @@ led to it, the map and the camera. The first test that holds, in this precedence
 
 ``missed``
     the evader's centre is in view (inside the FOV wedge, within [near, far], in line of
-    sight on the grid: :func:`pegame.visibility.in_view`, the point the built-in
-    detectors test), yet no detection: the detector missed a geometrically visible
+    sight on the grid: :func:`pegame.visibility.in_view`, the point the oracle detector
+    tests), yet no detection: the detector missed a geometrically visible
     evader (the perception model's misses, rate, latency and detection range; a 3D
     detector's miss in its rendered image).
 ``blocked``
@@ -32,7 +32,7 @@ The geometric causes are disjoint from ``missed`` (the evader is in view or not)
 pursuer's own state comes before the geometry because it says why the camera did not
 follow (a pursuer stuck at a wall or spinning on the spot loses an evader that then lies
 sideways, behind a wall or out of range). The test is on the evader's centre, as the
-built-in detectors' is: a shoulder still showing past a corner (``in_view`` of the game's
+oracle's is: a shoulder still showing past a corner (``in_view`` of the game's
 ground truth, :func:`pegame.visibility.body_in_view`) does not make the loss a miss.
 
 A loss ends when the pair's detector reports the evader again: its *time to reacquire*
@@ -55,7 +55,6 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from pegame.types import Body, Camera, Detection, Pose, Velocity, clamp, value_type, wrap_angle
-from pegame.visibility import in_view, line_of_sight
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from pegame.api import Context
@@ -108,6 +107,10 @@ def loss_cause(
     """The cause (module docstring) of a loss at a tick where the pursuer (``body``) is
     at ``after`` having held ``command`` for ``dt`` s from ``before``, and the evader's
     centre at ``evader_xy`` (map frame, m)."""
+    # imported here, at a loss: pegame.api (Tick.losses) and the report import this module
+    # without the visibility kernels
+    from pegame.visibility import in_view, line_of_sight
+
     if in_view(grid, camera, after, evader_xy):
         return MISSED
     moved = math.hypot(after.x - before.x, after.y - before.y)
