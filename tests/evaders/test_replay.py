@@ -13,6 +13,7 @@ from pegame.errors import ConfigError
 from pegame.evaders.replay import arc_command, load_recording, recording_path, shipped
 from pegame.game import Game, write_outcome
 from pegame.sims.grid import unicycle
+from pegame.testing import EvaderConformance
 from pegame.types import Pose, Velocity
 
 
@@ -92,3 +93,9 @@ def test_a_recorded_game_is_played_again_and_stays_as_recorded_against_another_p
 def test_a_replay_without_a_path_names_the_shipped_recordings():
     with pytest.raises(ConfigError, match="evader.path.*hider"):
         Game(compose(["recorder=none", "evader=replay"]))
+
+
+class TestConformance(EvaderConformance):
+    plugin = "replay"
+    overrides = ("evader.path=hider",)
+    bad_values = {"v_max": -1.0}
