@@ -106,24 +106,25 @@ def play(args: argparse.Namespace) -> int:
             f"({exc.strerror or exc}). Allowed: an address of this machine and a free port "
             "(--port 0 picks one)."
         ) from None
-    if args.host not in LOOPBACK:
-        print(f"pegame.play: listening on {args.host}, reachable from other machines")
-    print(f"pegame.play: open {url} in a browser (Ctrl-C stops)", flush=True)
-    activate(session)
-    played, status = 0, sweep.OK
+    played, status, playing = 0, sweep.OK, False
     try:
+        if args.host not in LOOPBACK:
+            print(f"pegame.play: listening on {args.host}, reachable from other machines")
+        print(f"pegame.play: open {url} in a browser (Ctrl-C stops)", flush=True)
+        activate(session)
         while not args.games or played < args.games:
             session.starts.acquire()
             if not session.connected:
                 if played:
                     break  # the page closed after a game: nobody is left to play
                 continue
-            played += 1
+            played, playing = played + 1, True
             status = max(status, play_one(cfg, session, out / f"game_{played}", played, args))
+            playing = False
             if not session.connected:
                 break
     except KeyboardInterrupt:
-        if session.connected and session.evader_taken:
+        if playing:
             print("pegame.play: interrupted during a game", file=sys.stderr)
             return 130
     finally:

@@ -26,7 +26,7 @@ from importlib import resources
 from typing import Any
 from urllib.parse import urlsplit
 
-from aiohttp import WSMsgType, web
+from aiohttp import WSCloseCode, WSMsgType, web
 
 from pegame.play.session import Session
 
@@ -50,8 +50,11 @@ def handle_message(session: Session, message: dict[str, Any]) -> None:
         session.frame_drawn(message["sent"], message["drawn"])
 
 
-def make_app(session: Session) -> web.Application:
-    """The page's application for ``session``."""
+def make_app(
+    session: Session, sockets: set[web.WebSocketResponse] | None = None
+) -> web.Application:
+    """The page's application for ``session``; ``sockets`` holds its open WebSockets."""
+    sockets = set() if sockets is None else sockets
 
     async def page(request: web.Request) -> web.Response:
         return _file("index.html")
@@ -69,6 +72,7 @@ def make_app(session: Session) -> web.Application:
         if not session.connect():
             raise web.HTTPConflict(text="Another page is playing this game; one person plays it.")
         ws = web.WebSocketResponse(heartbeat=10.0)
+        sockets.add(ws)
         try:
             await ws.prepare(request)
             wake = asyncio.Event()
@@ -92,6 +96,7 @@ def make_app(session: Session) -> web.Application:
             finally:
                 sender.cancel()
         finally:
+            sockets.discard(ws)
             session.notify = lambda: None
             session.disconnect()
         return ws
@@ -125,7 +130,8 @@ class Server:
     def __init__(self, session: Session, host: str = "127.0.0.1", port: int = 8765) -> None:
         self.session, self.host, self.port = session, host, port
         self.loop = asyncio.new_event_loop()
-        self.runner = web.AppRunner(make_app(session), handle_signals=False)
+        self.sockets: set[web.WebSocketResponse] = set()
+        self.runner = web.AppRunner(make_app(session, self.sockets), handle_signals=False)
         self.thread = threading.Thread(
             target=self.loop.run_forever, name="pegame-play", daemon=True
         )
@@ -142,10 +148,16 @@ class Server:
         host = f"[{self.host}]" if ":" in self.host else self.host
         return f"http://{host}:{port}/"
 
+    async def _shutdown(self) -> None:
+        """Close the open page (it says the server closed the game), then the server."""
+        for ws in list(self.sockets):
+            await ws.close(code=WSCloseCode.GOING_AWAY, message=b"the server stopped")
+        await self.runner.cleanup()
+
     def stop(self) -> None:
         """Close the connections and the server, and end its thread."""
         if self.thread.is_alive():
-            asyncio.run_coroutine_threadsafe(self.runner.cleanup(), self.loop).result(timeout=10)
+            asyncio.run_coroutine_threadsafe(self._shutdown(), self.loop).result(timeout=10)
             self.loop.call_soon_threadsafe(self.loop.stop)
             self.thread.join(timeout=10)
         self.loop.close()

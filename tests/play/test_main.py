@@ -4,6 +4,7 @@ is exit 2 before anything is served."""
 
 import asyncio
 import json
+import signal
 import time
 
 import aiohttp
@@ -115,3 +116,26 @@ def test_a_page_closed_during_a_game_fails_it_recorded_and_exit_1(tmp_path):
     assert [line["kind"] for line in lines] == ["failed", "summary"]
     assert lines[0]["error"].startswith("PageClosed")
     assert not (tmp_path / "game_1" / "result.json").exists()
+
+
+@pytest.mark.slow
+def test_ctrl_c_during_a_game_is_exit_130_and_between_games_the_games_status(tmp_path):
+    overrides = ["game.t_max=30", "pursuer=random", "estimator=last_seen", "recorder=none"]
+    with served(overrides, tmp_path / "during") as (process, url):
+
+        async def interrupt():
+            async with aiohttp.ClientSession() as client, client.ws_connect(url + "ws") as ws:
+                await ws.send_json({"type": "start"})
+                async for message in ws:
+                    if json.loads(message.data)["type"] == "frame":
+                        process.send_signal(signal.SIGINT)
+                        break
+                await asyncio.sleep(0.5)
+
+        asyncio.run(interrupt())
+        output, _ = process.communicate(timeout=60)
+    assert process.returncode == 130, output
+    with served(overrides, tmp_path / "between") as (process, url):
+        process.send_signal(signal.SIGINT)
+        output, _ = process.communicate(timeout=60)
+    assert process.returncode == 0, output
