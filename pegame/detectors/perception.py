@@ -45,8 +45,8 @@ with a function that captures one (applying the per-detection parts: range, miss
 noise, through :meth:`Perception.degrade` or the building blocks), and the pipeline adds
 rate, latency, bursts and false positives.
 
-The pipeline's schedule (:func:`frame_due`, :func:`deliver_frame`, on a
-:class:`Pipeline` of a batch of detectors) and the range and occlusion miss chance
+The pipeline's schedule (:func:`frame_due`, :func:`deliver_frame`, on the pipelines of a
+batch of detectors, :func:`new_pipeline`) and the range and occlusion miss chance
 (:func:`miss_chance`) are numba kernels: a :class:`Perception` runs them on a batch of
 one, the batched game (:mod:`pegame.vector`) on its games, so the two are one model.
 The results in flight are the caller's (a slot index per result: Python objects here,
@@ -58,7 +58,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, NamedTuple
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from numba import njit
@@ -77,9 +77,10 @@ TIME_TOLERANCE = 1e-9
 PERSON_HEIGHT = 1.7
 #: the generators the parts draw from, one each, spawned from the detector's in this order
 PARTS = ("burst", "range", "bearing", "false_positive", "independent", "noise")
-#: columns of a pipeline's clock: the first capture's time (s; NaN before it), the frames
-#: counted from it, the last capture's time (s; NaN before it)
-FIRST, CAPTURES, LAST = range(3)
+#: columns of a pipeline's row (:func:`new_pipeline`): the first capture's time (s; NaN
+#: before it), the frames counted from it, the last capture's time (s; NaN before it), the
+#: ring's first slot and its length, and the first slot's delivery time (s)
+FIRST, CAPTURES, LAST, HEAD, SIZE, DUE = range(6)
 
 
 @dataclass
@@ -236,67 +237,48 @@ def hidden_fraction(
     return hidden / len(SILHOUETTE)
 
 
-class Pipeline(NamedTuple):
-    """The pipelines of a batch of detectors, first axis the detector (a game's).
-
-    clock (N, 3) float64: FIRST, CAPTURES, LAST; due (N, K) float64: the delivery times
-    (s) of the results in flight, a ring of K slots (:func:`pipeline_slots`) starting at
-    head (N,) int64 and holding size (N,) int64 of them.
-    """
-
-    clock: np.ndarray
-    due: np.ndarray
-    head: np.ndarray
-    size: np.ndarray
-
-
 def pipeline_slots(latency: float, period: float) -> int:
     """Slots enough for the results in flight: at most one capture per ``period`` s, each
     held ``latency`` s."""
     return int(math.floor(latency / period + TIME_TOLERANCE)) + 2
 
 
-def new_pipeline(detectors: int, slots: int) -> Pipeline:
-    """Empty pipelines (:func:`reset_pipeline`) of ``detectors`` detectors."""
-    pipeline = Pipeline(
-        np.empty((detectors, 3)),
-        np.zeros((detectors, slots)),
-        np.zeros(detectors, np.int64),
-        np.zeros(detectors, np.int64),
-    )
+def new_pipeline(detectors: int, slots: int) -> np.ndarray:
+    """Empty pipelines (:func:`reset_pipeline`) of ``detectors`` detectors: float64
+    (detectors, DUE + ``slots``), one row per detector: its clock (FIRST, CAPTURES, LAST),
+    the ring of results in flight (HEAD, the first one's slot, and SIZE, how many) and
+    from column DUE the delivery times (s) of the slots. One array, so that a scalar
+    detector's call of the kernels checks one argument's type."""
+    pipeline = np.zeros((detectors, DUE + slots))
     reset_pipeline(pipeline, np.arange(detectors))
     return pipeline
 
 
-def reset_pipeline(pipeline: Pipeline, detectors: np.ndarray | int) -> None:
-    """Start a new game in the pipelines ``detectors`` (indices): nothing captured, nothing
-    in flight."""
-    pipeline.clock[detectors] = (math.nan, 0.0, math.nan)
-    pipeline.head[detectors] = 0
-    pipeline.size[detectors] = 0
+def reset_pipeline(pipeline: np.ndarray, detectors: np.ndarray | int) -> None:
+    """Start a new game in the pipelines ``detectors`` (row indices): nothing captured,
+    nothing in flight."""
+    pipeline[detectors, :DUE] = (math.nan, 0.0, math.nan, 0.0, 0.0)
 
 
 @njit(cache=True)
 def frame_due(
-    clock: np.ndarray, k: int, time: float, period: float, rated: bool
+    pipeline: np.ndarray, k: int, time: float, period: float, rated: bool
 ) -> tuple[bool, float]:
-    """Whether detector ``k`` captures a frame at ``time`` (s): every call without a rate
-    (``rated`` False), else at whole capture periods ``period`` (s) from its first
-    capture (counted, not summed, so the schedule does not drift); and the time (s)
-    since its last capture (``period`` before the first). ``clock``: Pipeline.clock."""
-    if math.isnan(clock[k, FIRST]):
-        clock[k, FIRST] = time
-    due = not rated or time >= clock[k, FIRST] + clock[k, CAPTURES] * period - TIME_TOLERANCE
-    last = clock[k, LAST]
+    """Whether detector ``k`` (a row of ``pipeline``) captures a frame at ``time`` (s):
+    every call without a rate (``rated`` False), else at whole capture periods ``period``
+    (s) from its first capture (counted, not summed, so the schedule does not drift); and
+    the time (s) since its last capture (``period`` before the first)."""
+    if math.isnan(pipeline[k, FIRST]):
+        pipeline[k, FIRST] = time
+    next_frame = pipeline[k, FIRST] + pipeline[k, CAPTURES] * period
+    due = not rated or time >= next_frame - TIME_TOLERANCE
+    last = pipeline[k, LAST]
     return due, period if math.isnan(last) else time - last
 
 
 @njit(cache=True)
 def deliver_frame(
-    clock: np.ndarray,
-    due: np.ndarray,
-    head: np.ndarray,
-    size: np.ndarray,
+    pipeline: np.ndarray,
     k: int,
     time: float,
     period: float,
@@ -304,7 +286,7 @@ def deliver_frame(
     latency: float,
     captured: bool,
 ) -> tuple[int, int, float]:
-    """Detector ``k``'s pipeline (the arrays of a :class:`Pipeline`) at ``time`` (s) after
+    """Detector ``k``'s pipeline (a row of ``pipeline``) at ``time`` (s) after
     :func:`frame_due`: a frame ``captured`` goes in flight for ``latency`` s in the slot
     returned first (-1 when none was captured), and the frames a rate skips are counted;
     the second slot returned is that of the last result delivered by ``time`` (-1: none,
@@ -313,23 +295,26 @@ def deliver_frame(
     which the pipeline certainly does nothing (no frame due, no result delivered; -inf
     without a rate), two tolerances before its next event, so that a caller may skip the
     kernels until then and play the same."""
-    slots = due.shape[1]
+    row = pipeline[k]
+    slots = row.size - DUE
+    head, size = int(row[HEAD]), int(row[SIZE])
     slot_in = -1
     if captured:
-        slot_in = (head[k] + size[k]) % slots
-        due[k, slot_in] = time + latency
-        size[k] += 1
-        clock[k, LAST] = time
-        while rated and clock[k, FIRST] + clock[k, CAPTURES] * period <= time + TIME_TOLERANCE:
-            clock[k, CAPTURES] += 1.0  # past this frame, and past the frames a high rate skips
+        slot_in = (head + size) % slots
+        row[DUE + slot_in] = time + latency
+        size += 1
+        row[LAST] = time
+        while rated and row[FIRST] + row[CAPTURES] * period <= time + TIME_TOLERANCE:
+            row[CAPTURES] += 1.0  # past this frame, and past the frames a high rate skips
     slot_out = -1
-    while size[k] > 0 and due[k, head[k]] <= time + TIME_TOLERANCE:
-        slot_out = head[k]
-        head[k] = (slot_out + 1) % slots
-        size[k] -= 1
-    quiet = clock[k, FIRST] + clock[k, CAPTURES] * period if rated else -math.inf
-    if size[k] > 0:
-        quiet = min(quiet, due[k, head[k]])
+    while size > 0 and row[DUE + head] <= time + TIME_TOLERANCE:
+        slot_out = head
+        head = (head + 1) % slots
+        size -= 1
+    row[HEAD], row[SIZE] = head, size
+    quiet = row[FIRST] + row[CAPTURES] * period if rated else -math.inf
+    if size > 0:
+        quiet = min(quiet, row[DUE + head])
     return slot_in, slot_out, quiet - 2.0 * TIME_TOLERANCE
 
 
@@ -388,7 +373,7 @@ class Perception:
         """Start a new game: empty pipeline, nothing held, the burst chain undrawn."""
         reset_pipeline(self.pipeline, 0)
         self._quiet_until = -math.inf  # s, see deliver_frame
-        self._in_flight: list[Detection | None] = [None] * self.pipeline.due.shape[1]
+        self._in_flight: list[Detection | None] = [None] * (self.pipeline.shape[1] - DUE)
         self._held: Detection | None = None
         self._bursting: bool | None = None
 
@@ -411,8 +396,8 @@ class Perception:
             return capture()
         if time < self._quiet_until:  # between events: the kernels would do nothing
             return self._held
-        clock, due_times, head, size = self.pipeline
-        due, dt = frame_due(clock, 0, time, self.period, self.rated)
+        pipeline = self.pipeline
+        due, dt = frame_due(pipeline, 0, time, self.period, self.rated)
         result = None
         if due:
             result = capture()
@@ -421,9 +406,8 @@ class Perception:
             if result is None:
                 height = self.camera_height if camera_height is None else camera_height
                 result = self._false_positive(dt, pose, height)
-        latency = self.config.latency
         slot_in, slot_out, self._quiet_until = deliver_frame(
-            clock, due_times, head, size, 0, time, self.period, self.rated, latency, due
+            pipeline, 0, time, self.period, self.rated, self.config.latency, due
         )
         if slot_in >= 0:
             self._in_flight[slot_in] = result

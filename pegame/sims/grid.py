@@ -10,8 +10,11 @@ one is cut at the last free sample, so the agent stops at the wall and may still
 The agents do not collide with each other (the paper's agents never need to touch; the
 spawn starts them apart).
 
-The swept collision check is a numba kernel (:func:`_sweep`); ``_sweep_reference`` is the
-plain-Python loop it reproduces, which the tests compare it against.
+An agent's move is one numba kernel (:func:`move`: saturation, acceleration limits, the
+arc of :func:`arc`, the swept collision check :func:`_sweep`) on a batch of agents' state
+arrays: each agent of this simulator runs it on a batch of one, the batched game
+(:mod:`pegame.vector`) on every game's pursuer and evader. ``_sweep_reference`` is the
+plain-Python loop the sweep reproduces, which the tests compare it against.
 """
 
 from __future__ import annotations
@@ -25,8 +28,20 @@ from numba import njit
 
 from pegame.api import Context, Simulator
 from pegame.grid import OccupancyGrid, cell_blocked, point_cell
+from pegame.grid.occupancy import RESOLUTION
 from pegame.navigation import shared_inflation
-from pegame.types import STOP, Body, Pose, SensorFrame, Velocity, clamp, wrap_angle
+from pegame.numerics import ceil_of_hypot, hypot, wrap_angle
+from pegame.types import STOP, Body, Pose, SensorFrame, Velocity, clamp
+
+#: columns of the bodies' rows the move kernel reads: radius (m), v_max (m/s), w_max
+#: (rad/s), a_max (m/s^2), alpha_max (rad/s^2)
+RADIUS, V_MAX, W_MAX, A_MAX, ALPHA_MAX = range(5)
+
+
+def body_rows(*bodies: Body) -> np.ndarray:
+    """The (A, 5) float64 rows of :func:`move`'s ``bodies``, one per body."""
+    rows = [[b.radius, b.v_max, b.w_max, b.a_max, b.alpha_max] for b in bodies]
+    return np.array(rows, dtype=np.float64)
 
 
 def saturate(cmd: Velocity, body: Body) -> Velocity:
@@ -43,11 +58,35 @@ def accelerate(current: Velocity, cmd: Velocity, body: Body, dt: float) -> Veloc
     )
 
 
+@njit(cache=True, inline="always")
+def _clamp(value: float, limit: float) -> float:
+    """:func:`pegame.types.clamp`: min(max(value, -limit), limit) with Python's min/max."""
+    low = value if value > -limit else -limit
+    return low if low < limit else limit
+
+
+@njit(cache=True, inline="always")
 def _ramp(current: float, target: float, limit: float) -> float:
     """``target``, or ``current`` moved towards it by at most ``limit``."""
     if math.isinf(limit):
         return target  # no limit: exactly today's command, not current + (target - current)
-    return current + clamp(target - current, limit)
+    return current + _clamp(target - current, limit)
+
+
+@njit(cache=True, inline="always")
+def arc(
+    x: float, y: float, theta: float, v: float, w: float, dt: float
+) -> tuple[float, float, float]:
+    """The end pose (x, y, theta) (m, rad in (-pi, pi]; map frame) of the arc of (v, w)
+    held for ``dt`` s from (x, y, theta): :func:`unicycle`."""
+    end = theta + w * dt
+    if abs(w) < 1e-9:
+        dx, dy = v * dt * math.cos(theta), v * dt * math.sin(theta)
+    else:
+        radius = v / w
+        dx = radius * (math.sin(end) - math.sin(theta))
+        dy = -radius * (math.cos(end) - math.cos(theta))
+    return x + dx, y + dy, wrap_angle(end)
 
 
 def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
@@ -63,14 +102,7 @@ def unicycle(pose: Pose, cmd: Velocity, dt: float) -> Pose:
     and changes the last bits of every turning move: it belongs to a release that may
     change games.
     """
-    theta = pose.theta + cmd.w * dt
-    if abs(cmd.w) < 1e-9:
-        dx, dy = cmd.v * dt * math.cos(pose.theta), cmd.v * dt * math.sin(pose.theta)
-    else:
-        radius = cmd.v / cmd.w
-        dx = radius * (math.sin(theta) - math.sin(pose.theta))
-        dy = -radius * (math.cos(theta) - math.cos(pose.theta))
-    return Pose(pose.x + dx, pose.y + dy, wrap_angle(theta))
+    return Pose(*arc(pose.x, pose.y, pose.theta, cmd.v, cmd.w, dt))
 
 
 @njit(cache=True)
@@ -97,6 +129,49 @@ def _sweep(
     return x, y
 
 
+@njit(cache=True, inline="always")
+def move(
+    blocked: np.ndarray,
+    frame: np.ndarray,
+    bodies: np.ndarray,
+    poses: np.ndarray,
+    velocities: np.ndarray,
+    k: int,
+    agent: int,
+    v: float,
+    w: float,
+    dt: float,
+) -> tuple[float, float, float]:
+    """Move ``agent`` of batch entry ``k`` by the command (v m/s, w rad/s) for ``dt`` s:
+    saturated to its body's limits, its change from the current velocity limited by
+    a_max and alpha_max (the velocity kept only with a finite limit), the arc
+    (:func:`arc`), cut at the last free sample of the chord at half-cell spacing
+    (:func:`_sweep` on ``blocked``, the agent's collision mask; an agent stopped by a wall
+    loses its forward speed and keeps its turn rate). ``frame``: the grid's kernel_frame
+    as float64; bodies (A, 5): columns RADIUS..ALPHA_MAX per agent; poses (B, A, 3) (x, y,
+    theta) and velocities (B, A, 2) (v, w), updated in place. Returns the new pose.
+    Elements are read by index, not through row views, and arrays are passed, not
+    NamedTuples: the batched game inlines it per game, where a view, and an inlined
+    function given a NamedTuple, cost a reference count per array."""
+    x0, y0, theta0 = poses[k, agent, 0], poses[k, agent, 1], poses[k, agent, 2]
+    v = _clamp(v, bodies[agent, V_MAX])
+    w = _clamp(w, bodies[agent, W_MAX])
+    a_max, alpha_max = bodies[agent, A_MAX], bodies[agent, ALPHA_MAX]
+    limited = not (math.isinf(a_max) and math.isinf(alpha_max))
+    if limited:
+        v = _ramp(velocities[k, agent, 0], v, a_max * dt)
+        w = _ramp(velocities[k, agent, 1], w, alpha_max * dt)
+    tx, ty, theta = arc(x0, y0, theta0, v, w, dt)
+    n = max(1, ceil_of_hypot(tx - x0, ty - y0, frame[RESOLUTION]))
+    x, y = _sweep(blocked, x0, y0, tx, ty, n, frame)
+    poses[k, agent, 0], poses[k, agent, 1], poses[k, agent, 2] = x, y, theta
+    if limited:
+        stopped = hypot(tx - x, ty - y) > 1e-9
+        velocities[k, agent, 0] = 0.0 if stopped else v
+        velocities[k, agent, 1] = w
+    return x, y, theta
+
+
 def _sweep_reference(
     grid: OccupancyGrid,
     blocked: np.ndarray,
@@ -119,35 +194,58 @@ def _sweep_reference(
 
 
 class _Agent:
-    """One agent's body, its collision mask (shared, read-only) and its pose."""
+    """One agent's body, its collision mask (shared, read-only) and its pose: a batch of
+    one of :func:`move`'s arrays."""
 
     def __init__(self, grid: OccupancyGrid, body: Body) -> None:
         self.grid = grid
         self.body = body
         self.blocked = shared_inflation(grid, body.radius)
         self.frame = grid.kernel_frame
-        self.pose = Pose(0.0, 0.0, 0.0)
-        self.velocity = STOP
+        self._frame = np.array(grid.kernel_frame, dtype=np.float64)
+        self._bodies = body_rows(body)
+        self._poses = np.zeros((1, 1, 3))
+        self._velocities = np.zeros((1, 1, 2))
+        self._pose = Pose(0.0, 0.0, 0.0)
         # Without acceleration limits the command is the velocity: no state to keep.
         self.limited = not (math.isinf(body.a_max) and math.isinf(body.alpha_max))
+
+    @property
+    def pose(self) -> Pose:
+        return self._pose
+
+    @pose.setter
+    def pose(self, pose: Pose) -> None:
+        self._pose = pose
+        self._poses[0, 0] = (pose.x, pose.y, pose.theta)
+
+    @property
+    def velocity(self) -> Velocity:
+        """The current velocity (kept with acceleration limits only)."""
+        v, w = self._velocities[0, 0].tolist()
+        return Velocity(v, w)
+
+    @velocity.setter
+    def velocity(self, velocity: Velocity) -> None:
+        self._velocities[0, 0] = (velocity.v, velocity.w)
 
     def collides(self, x: float, y: float) -> bool:
         return cell_blocked(self.blocked, *point_cell(x, y, self.frame))
 
     def move(self, cmd: Velocity, dt: float) -> None:
-        start = self.pose
-        velocity = saturate(cmd, self.body)
-        if self.limited:
-            velocity = accelerate(self.velocity, velocity, self.body, dt)
-        target = unicycle(start, velocity, dt)
-        # Sample the chord at half-cell spacing so that no move skips over a thin wall.
-        n = max(1, math.ceil(2 * start.distance_to(target) / self.grid.resolution))
-        x, y = _sweep(self.blocked, start.x, start.y, target.x, target.y, n, self.frame)
-        self.pose = Pose(x, y, target.theta)
-        if self.limited:
-            # An agent stopped by a wall has lost its forward speed; it keeps its turn rate.
-            blocked = math.hypot(target.x - x, target.y - y) > 1e-9
-            self.velocity = Velocity(0.0, velocity.w) if blocked else velocity
+        x, y, theta = move(
+            self.blocked,
+            self._frame,
+            self._bodies,
+            self._poses,
+            self._velocities,
+            0,
+            0,
+            cmd.v,
+            cmd.w,
+            dt,
+        )
+        self._pose = Pose(x, y, theta)
 
 
 class GridSimulator(Simulator):

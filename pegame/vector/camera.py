@@ -339,7 +339,7 @@ def _deliver(
     camera, perception = rules.camera, rules.perception
     poses = state.poses
     period, rated = perception[PERIOD], perception[RATED] != 0.0
-    due, _ = frame_due(state.clock, game, time, period, rated)
+    due, _ = frame_due(state.pipeline, game, time, period, rated)
     if due:
         centre = detect(
             frame,
@@ -359,18 +359,8 @@ def _deliver(
         px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
         ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
         centre = point_in_view(frame, blocked, values, camera, px, py, ptheta, ex, ey)
-    slot_in, slot_out, _ = deliver_frame(
-        state.clock,
-        state.due,
-        state.head,
-        state.size,
-        game,
-        time,
-        period,
-        rated,
-        perception[LATENCY],
-        due,
-    )
+    latency = perception[LATENCY]
+    slot_in, slot_out, _ = deliver_frame(state.pipeline, game, time, period, rated, latency, due)
     if slot_in >= 0:
         state.in_flight_detected[game, slot_in] = state.captured[game]
         state.in_flight[game, slot_in, :] = state.capture[game, :]

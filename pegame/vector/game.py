@@ -59,7 +59,6 @@ from pegame.api import Context
 from pegame.detectors.oracle import OracleDetector
 from pegame.detectors.perception import (
     PerceptionConfig,
-    Pipeline,
     capture_period,
     detection_range,
     misses_by_range_or_occlusion,
@@ -75,7 +74,7 @@ from pegame.errors import ConfigError
 from pegame.game import STREAMS, Scenario, spawn
 from pegame.grid import OccupancyGrid
 from pegame.navigation import shared_inflation
-from pegame.sims.grid import GridSimulator
+from pegame.sims.grid import GridSimulator, body_rows
 from pegame.vector import kernels
 from pegame.vector.features import features
 from pegame.vector.metrics import new_tally, summary
@@ -211,7 +210,7 @@ class BatchedGame:
         state.has_seen[games] = False
         state.tally[games] = new_tally()
         state.detected[games] = False  # nothing delivered yet
-        reset_pipeline(Pipeline(state.clock, state.due, state.head, state.size), games)
+        reset_pipeline(state.pipeline, games)
         state.drawn[games] = 0
         kernels.sense_games(self.world, self.rules, state, games)
         if opponent is not None:
@@ -337,13 +336,7 @@ def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
 def _rules(scenario: Scenario) -> Rules:
     context, settings = scenario.context, scenario.settings
     camera, detector = context.camera, scenario.configs["detector"]
-    bodies = np.array(
-        [
-            [body.radius, body.v_max, body.w_max, body.a_max, body.alpha_max]
-            for body in (context.pursuer, context.evader)
-        ],
-        dtype=np.float64,
-    )
+    bodies = body_rows(context.pursuer, context.evader)
     numbers = np.array(
         [
             camera.fov,

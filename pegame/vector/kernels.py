@@ -6,9 +6,9 @@ is the single game's, in the same order and with the same float operations, so a
 played here is the game the plain-Python code plays (``tests/test_vector_env.py``
 compares them step by step):
 
-- :func:`move` is :class:`pegame.sims.grid.GridSimulator`'s agent move (saturation,
-  acceleration limits, exact unicycle arc, the swept collision check
-  :func:`pegame.sims.grid._sweep` itself);
+- :func:`pegame.sims.grid.move` is the grid simulator's own move kernel (saturation,
+  acceleration limits, the unicycle arc, the swept collision check), which its agents
+  run on a batch of one;
 - :func:`pegame.vector.camera.sense` is the detector and the ground truth;
 - :func:`tally` accumulates :class:`pegame.metrics.TrackingMetrics` as running sums
   (:mod:`pegame.vector.metrics` turns them into its summary);
@@ -23,13 +23,9 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from pegame.grid.occupancy import RESOLUTION
-from pegame.numerics import ceil_of_hypot, hypot, wrap_angle
-from pegame.sims.grid import _sweep
+from pegame.sims.grid import move
 from pegame.vector.camera import sense
 from pegame.vector.state import (
-    A_MAX,
-    ALPHA_MAX,
     DETECTED,
     DISTANCE_SUM,
     EVADER,
@@ -50,69 +46,10 @@ from pegame.vector.state import (
     REACQUIRE_SUM,
     REACQUISITIONS,
     TICKS,
-    V_MAX,
-    W_MAX,
     BatchState,
     Rules,
     World,
 )
-
-
-@njit(cache=True, inline="always")
-def _clamp(value: float, limit: float) -> float:
-    """:func:`pegame.types.clamp`: min(max(value, -limit), limit) with Python's min/max."""
-    low = value if value > -limit else -limit
-    return low if low < limit else limit
-
-
-@njit(cache=True, inline="always")
-def _ramp(current: float, target: float, limit: float) -> float:
-    """:func:`pegame.sims.grid._ramp`."""
-    if math.isinf(limit):
-        return target
-    return current + _clamp(target - current, limit)
-
-
-@njit(cache=True, inline="always")
-def move(
-    masks: np.ndarray,
-    frame: np.ndarray,
-    bodies: np.ndarray,
-    poses: np.ndarray,
-    velocities: np.ndarray,
-    commands: np.ndarray,
-    game: int,
-    role: int,
-    dt: float,
-) -> None:
-    """Move ``role`` of ``game`` by its command for ``dt`` s (the grid simulator's move),
-    from the world's masks and frame, rules.bodies and the state's poses, velocities and
-    commands. Elements are read by index, not through row views, and the arrays are
-    passed, not the NamedTuples: a view, and an inlined function given a NamedTuple, cost
-    a reference count per array."""
-    x0, y0, theta0 = poses[game, role, 0], poses[game, role, 1], poses[game, role, 2]
-    v = _clamp(commands[game, role, 0], bodies[role, V_MAX])
-    w = _clamp(commands[game, role, 1], bodies[role, W_MAX])
-    a_max, alpha_max = bodies[role, A_MAX], bodies[role, ALPHA_MAX]
-    limited = not (math.isinf(a_max) and math.isinf(alpha_max))
-    if limited:
-        v = _ramp(velocities[game, role, 0], v, a_max * dt)
-        w = _ramp(velocities[game, role, 1], w, alpha_max * dt)
-    theta = theta0 + w * dt
-    if abs(w) < 1e-9:  # the arc of pegame.sims.grid.unicycle, operation for operation
-        dx, dy = v * dt * math.cos(theta0), v * dt * math.sin(theta0)
-    else:
-        radius = v / w
-        dx = radius * (math.sin(theta) - math.sin(theta0))
-        dy = -radius * (math.cos(theta) - math.cos(theta0))
-    tx, ty = x0 + dx, y0 + dy
-    n = max(1, ceil_of_hypot(tx - x0, ty - y0, frame[RESOLUTION]))
-    x, y = _sweep(masks[role], x0, y0, tx, ty, n, frame)
-    poses[game, role, 0], poses[game, role, 1], poses[game, role, 2] = x, y, wrap_angle(theta)
-    if limited:
-        stopped = hypot(tx - x, ty - y) > 1e-9
-        velocities[game, role, 0] = 0.0 if stopped else v
-        velocities[game, role, 1] = w
 
 
 @njit(cache=True, inline="always")
@@ -183,8 +120,10 @@ def _play_game(
             commands[game, table_role, 1] = table[game, decision, 1]
         tally(state.tally, poses, state.in_view, state.detected, game, rules.control_dt)
         for _ in range(rules.substeps):
-            move(masks, frame, bodies, poses, velocities, commands, game, PURSUER, dt)
-            move(masks, frame, bodies, poses, velocities, commands, game, EVADER, dt)
+            v, w = commands[game, PURSUER, 0], commands[game, PURSUER, 1]
+            move(masks[PURSUER], frame, bodies, poses, velocities, game, PURSUER, v, w, dt)
+            v, w = commands[game, EVADER, 0], commands[game, EVADER, 1]
+            move(masks[EVADER], frame, bodies, poses, velocities, game, EVADER, v, w, dt)
         steps[game] += 1
         sense(world, rules, state, game)
         state.rewards[game] += state.detected[game]

@@ -10,10 +10,17 @@ from typing import NamedTuple
 
 import numpy as np
 
+from pegame.detectors.perception import new_pipeline
+
+# the columns of ``rules.bodies``: the grid simulator's move kernel's
+from pegame.sims.grid import A_MAX as A_MAX
+from pegame.sims.grid import ALPHA_MAX as ALPHA_MAX
+from pegame.sims.grid import RADIUS as RADIUS
+from pegame.sims.grid import V_MAX as V_MAX
+from pegame.sims.grid import W_MAX as W_MAX
+
 #: the roles' index in the role axes
 PURSUER, EVADER = 0, 1
-#: columns of ``rules.bodies``
-RADIUS, V_MAX, W_MAX, A_MAX, ALPHA_MAX = range(5)
 #: entries of ``rules.camera``
 FOV, NEAR, FAR, IMAGE_WIDTH, IMAGE_HEIGHT, FOCAL, DETECTION_RANGE, BODY_HEIGHT, CAMERA_HEIGHT = (
     range(9)
@@ -113,8 +120,8 @@ class BatchState(NamedTuple):
     observation, with has_seen (N,); tally (N, TALLY_SIZE): the metrics' running sums;
     rewards (N,): detections counted in the current env step.
 
-    The perception pipeline, when it runs (delivered: detected and detection): clock,
-    due, head, size: its :class:`pegame.detectors.perception.Pipeline`, K slots; captured
+    The perception pipeline, when it runs (delivered: detected and detection): pipeline
+    (N, DUE + K): each game's (:func:`pegame.detectors.perception.new_pipeline`); captured
     (N,) and capture (N, 7): the tick's own capture; in_flight_detected (N, K) and
     in_flight (N, K, 7): the results in flight by slot; draws (N, D): each game's range
     stream drawn ahead (the range and occlusion misses), drawn (N,) of them used.
@@ -131,10 +138,7 @@ class BatchState(NamedTuple):
     has_seen: np.ndarray
     tally: np.ndarray
     rewards: np.ndarray
-    clock: np.ndarray
-    due: np.ndarray
-    head: np.ndarray
-    size: np.ndarray
+    pipeline: np.ndarray
     captured: np.ndarray
     capture: np.ndarray
     in_flight_detected: np.ndarray
@@ -159,10 +163,7 @@ def new_state(num_games: int, slots: int = 1, draws: int = 1) -> BatchState:
         np.zeros(n, np.bool_),
         np.zeros((n, TALLY_SIZE)),
         np.zeros(n),
-        np.zeros((n, 3)),
-        np.zeros((n, slots)),
-        np.zeros(n, np.int64),
-        np.zeros(n, np.int64),
+        new_pipeline(n, slots),
         np.zeros(n, np.bool_),
         np.zeros((n, DETECTION_SIZE)),
         np.zeros((n, slots), np.bool_),

@@ -18,7 +18,7 @@ from pegame.sims.grid import (
     unicycle,
 )
 from pegame.testing import walled_room
-from pegame.types import Body, Camera, Pose, Velocity
+from pegame.types import Body, Camera, Pose, Velocity, wrap_angle
 
 PURSUER = Body(radius=0.2, v_max=0.5, w_max=1.8)
 EVADER = Body(radius=0.25, v_max=0.5, w_max=1.8)
@@ -101,6 +101,51 @@ def test_fast_sweep_equals_reference():
             assert fast == _sweep_reference(grid, blocked, sx, sy, tx, ty, n)
             stops += fast != (tx, ty)
         assert 100 < stops < 2000
+
+
+def _move_reference(
+    grid, blocked, body: Body, pose: Pose, velocity: Velocity, cmd: Velocity, dt: float
+) -> tuple[Pose, Velocity]:
+    """The agent's move in plain Python, as the simulator played it before its kernel:
+    saturation, the acceleration ramp, the arc's difference of sines, the chord sampled at
+    half-cell spacing through the reference sweep."""
+    limited = not (math.isinf(body.a_max) and math.isinf(body.alpha_max))
+    command = saturate(cmd, body)
+    if limited:
+        command = accelerate(velocity, command, body, dt)
+    v, w = command.v, command.w
+    theta = pose.theta + w * dt
+    if abs(w) < 1e-9:
+        dx, dy = v * dt * math.cos(pose.theta), v * dt * math.sin(pose.theta)
+    else:
+        dx = v / w * (math.sin(theta) - math.sin(pose.theta))
+        dy = -v / w * (math.cos(theta) - math.cos(pose.theta))
+    tx, ty = pose.x + dx, pose.y + dy
+    n = max(1, math.ceil(2 * math.hypot(tx - pose.x, ty - pose.y) / grid.resolution))
+    x, y = _sweep_reference(grid, blocked, pose.x, pose.y, tx, ty, n)
+    stopped = math.hypot(tx - x, ty - y) > 1e-9
+    return Pose(x, y, wrap_angle(theta)), Velocity(0.0, w) if stopped else command
+
+
+@pytest.mark.parametrize("a_max", [math.inf, 0.8])
+@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-1.2, 0.7, 0.4)])
+def test_the_move_kernel_on_a_batch_of_one_is_the_plain_move(a_max, origin):
+    """The simulator's agents run the move kernel (the batched game's) on a batch of one:
+    the plain-Python move, bit for bit, through walls, ramps and turns."""
+    grid = walled_room(origin)
+    body = Body(0.2, 0.5, 1.8, a_max, 2 * a_max)
+    context = Context(grid, body, EVADER, Camera(), DT, 1.0)
+    sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
+    start = Pose(*grid.cell_to_world(10, 10), 0.3)
+    sim.reset(start, Pose(*grid.cell_to_world(50, 70)))
+    blocked = inflate(grid, body.radius)
+    pose, velocity = start, Velocity(0.0, 0.0)
+    rng = np.random.default_rng(4)
+    for _ in range(400):  # long enough to run into walls
+        cmd = Velocity(rng.uniform(-0.7, 0.7), rng.uniform(-2.5, 2.5))
+        pose, velocity = _move_reference(grid, blocked, body, pose, velocity, cmd, DT)
+        sim.step(cmd, Velocity(), DT)
+        assert sim.poses[0] == pose
 
 
 def test_start_inside_an_obstacle_is_refused():

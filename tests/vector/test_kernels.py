@@ -1,6 +1,6 @@
 """The batched game's kernels (pegame.vector) against the plain code they reproduce, bit for
-bit: the crop, the in-view tests and the simulator's move (Python's hypot and angle wrap in
-numba: tests/test_numerics.py)."""
+bit: the crop and the in-view tests (Python's hypot and angle wrap in numba:
+tests/test_numerics.py; the move is the grid simulator's own kernel, tests/sims)."""
 
 from __future__ import annotations
 
@@ -12,13 +12,10 @@ import pytest
 from pegame.envs.crop import local_crop_reference
 from pegame.envs.vector import vector_env
 from pegame.grid import OccupancyGrid
-from pegame.sims.grid import _Agent
-from pegame.types import Pose, Velocity
+from pegame.types import Pose
 from pegame.vector import camera as batched_camera
-from pegame.vector import kernels
 from pegame.vector.features import crop_into
 from pegame.vector.game import _world
-from pegame.vector.state import new_state
 from pegame.visibility import body_in_view, in_view
 from pegame.visibility.sight import _segment_clear
 
@@ -154,28 +151,3 @@ def test_segment_clear_on_cell_edges_is_the_sight_kernel(game):
         assert batched_camera.segment_clear(*sight, ax, ay, bx, by, 0.5 * res) == want
         clear.append(want)
     assert 0.05 < np.mean(clear) < 0.95  # both outcomes were tested
-
-
-@pytest.mark.parametrize("a_max", [math.inf, 0.8])
-def test_move_is_the_grid_simulators(game, a_max):
-    grid, context = game.context.grid, game.context
-    body = context.pursuer.__class__(context.pursuer.radius, 0.5, 1.8, a_max, 2 * a_max)
-    agent = _Agent(grid, body)
-    rules = game.rules._replace(bodies=np.array([[body.radius, 0.5, 1.8, a_max, 2 * a_max]] * 2))
-    state = new_state(1)
-    world = game.world._replace(masks=np.stack([agent.blocked, agent.blocked]))
-    rng = np.random.default_rng(4)
-    free = np.argwhere(~agent.blocked)
-    r, c = free[len(free) // 2]
-    x, y = grid.cell_to_world(r, c)
-    agent.pose = Pose(x, y, 0.3)
-    state.poses[0, 0] = (x, y, 0.3)
-    for _ in range(600):  # long enough to run into walls
-        v, w = rng.uniform(-0.7, 0.7), rng.uniform(-2.5, 2.5)
-        agent.move(Velocity(v, w), 0.1)
-        state.commands[0, 0] = (v, w)
-        arrays = world.masks, world.frame, rules.bodies
-        kernels.move(*arrays, state.poses, state.velocities, state.commands, 0, 0, 0.1)
-        assert tuple(state.poses[0, 0]) == (agent.pose.x, agent.pose.y, agent.pose.theta)
-        if agent.limited:
-            assert tuple(state.velocities[0, 0]) == (agent.velocity.v, agent.velocity.w)
