@@ -158,6 +158,7 @@ class FakeTerminal:
 
 def test_the_progress_bar_counts_games_as_they_are_stored(monkeypatch):
     from hydra.core.utils import JobReturn, JobStatus
+
     from hydra_plugins.pegame_launcher._pool import Progress
 
     terminal = FakeTerminal()
@@ -177,6 +178,7 @@ def test_the_progress_bar_counts_games_as_they_are_stored(monkeypatch):
 
 def test_without_a_terminal_each_cell_prints_a_line_with_the_games(monkeypatch, capsys):
     from hydra.core.utils import JobReturn, JobStatus
+
     from hydra_plugins.pegame_launcher._pool import Progress
 
     monkeypatch.setattr(sys.stderr, "isatty", lambda: False, raising=False)
