@@ -41,13 +41,14 @@ def test_bad_input_is_one_paragraph_and_exit_2_before_serving(capsys, overrides,
     assert err.startswith("pegame: error:") and message in err
 
 
-async def page(url: str, leave_after: float | None = None) -> list[dict]:
-    """A page without a browser: start a game, go forward and left, acknowledge frames;
-    leave ``leave_after`` s into the game (None: play to the result)."""
+async def page(url: str, leave_after: float | None = None, games: int = 1) -> list[dict]:
+    """A page without a browser: start a game, go forward and left, acknowledge frames,
+    and start another at its result, ``games`` in all; leave ``leave_after`` s into the
+    first game (None: play to the last result)."""
     received = []
     async with aiohttp.ClientSession() as client, client.ws_connect(url + "ws") as ws:
         await ws.send_json({"type": "start"})
-        started = None
+        started, results = None, 0
         async for message in ws:
             data = json.loads(message.data)
             received.append(data)
@@ -63,25 +64,29 @@ async def page(url: str, leave_after: float | None = None) -> list[dict]:
                 if leave_after is not None and time.monotonic() - started > leave_after:
                     break
             else:
-                break
+                results += 1
+                if results == games:
+                    break
+                await ws.send_json({"type": "start"})  # the page's "Another game"
     return received
 
 
 @pytest.mark.slow
-def test_a_played_game_writes_what_every_pegame_game_writes(tmp_path):
-    with served(["game.t_max=2", "pursuer=random", "estimator=last_seen"], tmp_path) as (
-        process,
-        url,
-    ):
+def test_played_games_write_what_every_pegame_game_writes(tmp_path):
+    overrides = ["game.t_max=2", "pursuer=random", "estimator=last_seen"]
+    with served(overrides, tmp_path, games=2) as (process, url):
         assert url.startswith("http://127.0.0.1:")
         started = time.monotonic()
-        received = asyncio.run(page(url))
+        received = asyncio.run(page(url, games=2))
         elapsed = time.monotonic() - started
         output, _ = process.communicate(timeout=60)
     assert process.returncode == 0, output
-    assert elapsed >= 2.0  # paced in real time: 20 ticks of 0.1 s
+    assert elapsed >= 4.0  # paced in real time: twice 20 ticks of 0.1 s
     kinds = [m["type"] for m in received]
-    assert kinds[0] == "game" and kinds[-1] == "result" and kinds.count("frame") >= 10
+    assert kinds[0] == "game" and kinds[-1] == "result" and kinds.count("frame") >= 20
+    games = [m for m in received if m["type"] == "game"]
+    assert [g["seed"] for g in games] == [0, 1]  # another game, another start
+    assert json.loads((tmp_path / "game_2" / "result.json").read_text())["seed"] == 1
     game_dir = tmp_path / "game_1"
     for name in ("result.json", "trajectory.csv", "game.rrd", "latency.json", "trajectory.png"):
         assert (game_dir / name).is_file(), name
