@@ -142,6 +142,7 @@ def play_one(
     with open_dict(game_cfg):
         game_cfg.game.seed = int(cfg.game.seed) + number - 1
     session.evader_taken, session.latencies = False, Latencies()
+    session.set_command(0.0, 0.0)  # the evader stands until the page sends a command
     try:
         run = run_job(game_cfg, out_dir, base_dir=os.getcwd(), overrides=list(args.overrides))
     finally:

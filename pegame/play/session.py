@@ -94,6 +94,7 @@ class Session:
             if self._connected:
                 return False
             self._connected = True
+            self._outbox, self._frame = [], None  # what a page that left did not get
             self._left.clear()
             return True
 

@@ -49,7 +49,9 @@ def test_one_page_holds_the_session_and_its_leaving_fails_the_game_and_stops_the
     with pytest.raises(PageClosed):
         session.wait(5.0)
     assert time.monotonic() - started < 1.0  # the leaving wakes the wait
+    session.send({"type": "result"})  # the page that left never gets it
     assert session.connect()  # a new page may take it
+    assert session.take() == []
 
 
 def test_latency_summary_counts_and_orders_the_samples():

@@ -192,6 +192,7 @@ function onMessage(event) {
     mapImage.src = message.map.image;
     sentCommand = { v: 0, w: 0 };
     playing = true;
+    sendCommand(performance.timeOrigin + performance.now()); // keys held from before
     statusText.textContent = `Playing on ${message.map.name}, seed ${message.seed}: escape!`;
     canvas.focus();
   } else if (message.type === "frame") {
