@@ -17,8 +17,8 @@ TickLoop.advance                       BatchedGame.step (per control tick)
 opponent observes; decides at a        opponent.command (a strategy per game, in Python),
 decision tick; gives its command       or the kernel reads the opponent's action table
 metrics.add(current tick)              kernels.tally
-_integrate: substeps, pursuer then     kernels.move(pursuer), kernels.move(evader), per
-evader (GridSimulator.step)            substep
+_integrate: substeps, pursuer then     sims.grid.move(pursuer), sims.grid.move(evader), per
+evader (GridSimulator.step)            substep (the simulator's own kernel)
 step += 1; _sense(): poses, detector,  steps += 1; camera.sense: camera.detect, then
 in_view                                camera.body_in_view
 EnvGame: reward += detection,          camera.sense (memory), state.rewards
