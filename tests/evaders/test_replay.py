@@ -79,6 +79,7 @@ def play(overrides, out_dir):
     return np.array(outcome.trajectory, dtype=float), outcome.header
 
 
+@pytest.mark.slow
 def test_a_recorded_game_is_played_again_and_stays_as_recorded_against_another_pursuer(tmp_path):
     recorded, columns = play(["evader=random"], tmp_path / "recorded")
     path = tmp_path / "recorded" / "trajectory.csv"
