@@ -4,8 +4,9 @@ on played games.
 Games are played in PyBullet (``sim=pybullet``, needs pegame-pybullet) with the reference
 segmentation detector driving the smart pursuer, so that both detectors see the same
 frames whatever the detector under test does; it runs beside the reference on every
-frame, and its latency is the wall-clock time of its ``detect`` on each new frame. Each
-frame falls in one of three classes:
+frame, and its latency is the wall-clock time of its ``detect`` on each new frame (and its
+CPU time, the process's over the same call, which a machine shared with other jobs does
+not inflate). Each frame falls in one of three classes:
 
 - positive: the reference sees the evader within ``max_range`` m (horizontal distance
   from the camera) with at least ``min_visible`` of its body visible (occlusion and the
@@ -72,6 +73,7 @@ class _Judge(Detector):
         self.max_range, self.min_visible = max_range, min_visible
         self.rows: list[Row] = []
         self.latencies: list[float] = []  # s, the detector under test's detect per new frame
+        self.cpu: list[float] = []  # s of this process's CPU time in the same calls
         self._frame: SensorFrame | None = None
 
     def reset(self) -> None:
@@ -83,10 +85,11 @@ class _Judge(Detector):
         if evader is None:
             raise RuntimeError("The evaluation needs frames that carry the evader's true pose.")
         truth = self.reference.detect(frame)
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         seen = self.vision.detect(frame)
         if frame is not self._frame:  # a reused frame costs nothing
             self.latencies.append(time.perf_counter() - start)
+            self.cpu.append(time.process_time() - cpu)
             self._frame = frame
         if truth is None:
             kind = "negative"
@@ -121,7 +124,7 @@ def evaluate(
 
     vision_cls = registry.load("detector", detector)
     vision_config = registry.make_config("detector", vision_cls, dict(vision or {}))
-    rows, latencies = [], []
+    rows, latencies, cpu = [], [], []
     with tempfile.TemporaryDirectory() as out:
         for seed in seeds:
             game = Game(
@@ -146,14 +149,19 @@ def evaluate(
             game.play(out)
             rows += judge.rows
             latencies += judge.latencies
-    return _score(rows, iou_threshold, latencies, detector)
+            cpu += judge.cpu
+    return _score(rows, iou_threshold, latencies, cpu, detector)
 
 
 def _score(
-    rows: list[Row], iou_threshold: float, latencies: list[float], name: str = "vision"
+    rows: list[Row],
+    iou_threshold: float,
+    latencies: list[float],
+    cpu: list[float],
+    name: str = "vision",
 ) -> dict[str, Any]:
     """The scores of recorded (kind, reference, vision, true evader pose) rows and the
-    detector's latencies (s), named ``<name>_precision`` and so on."""
+    detector's wall and CPU time per frame (s), named ``<name>_precision`` and so on."""
     positives = [  # a positive frame has the reference's detection
         (truth, seen, evader)
         for kind, truth, seen, evader in rows
@@ -174,6 +182,7 @@ def _score(
         f"{name}_position_error_m": float(np.median(errors)) if errors else None,
         f"{name}_latency_ms": 1e3 * float(np.median(latencies)) if latencies else None,
         f"{name}_latency_p95_ms": 1e3 * float(np.quantile(latencies, 0.95)) if latencies else None,
+        f"{name}_cpu_ms": 1e3 * float(np.median(cpu)) if cpu else None,
         "frames": len(rows),
         "positives": len(positives),
         "negatives": sum(1 for row in rows if row[0] == "negative"),
