@@ -4,11 +4,13 @@ the page of :mod:`pegame.play` through the session (latest-only: a slow page dro
 frames, never ticks).
 
 A frame holds only what the human evader's ``show`` lets the person see: always the
-time and the person's own pose; the pursuers' poses for ``pursuer`` or ``cone`` (the
-page draws each cone from the pose and the camera); the belief's mean and up to
-:data:`MAX_PARTICLES` of its particles for ``belief``. Poses are (x m, y m, theta rad)
+time and the person's own pose; the pursuers' poses for ``pursuer`` or ``cone``; for
+``cone``, each pursuer's view as the outline of its visibility region (walls hide what
+is behind them: :func:`pegame.visibility.outlines.visibility_outlines`, the polygon the
+Rerun recording draws, :data:`OUTLINE_RAYS` rays, as (x, y) points); the belief's mean
+and up to :data:`MAX_PARTICLES` of its particles for ``belief``. Poses are (x m, y m, theta rad)
 in the map frame; ``sent`` is the wall-clock time (ms since the epoch) the tick was
-handed over, from which the page measures its tick-to-frame latency.
+handed to this recorder, from which the page measures its tick-to-frame latency.
 """
 
 from __future__ import annotations
@@ -26,9 +28,12 @@ from pegame.api import Context, Recorder, Tick
 from pegame.errors import require
 from pegame.grid import OccupancyGrid
 from pegame.play.session import Session, active, now_ms
+from pegame.visibility.outlines import visibility_outlines
 
 #: the most particles of a belief a frame carries (evenly subsampled)
 MAX_PARTICLES = 300
+#: rays of a view cone's outline (:func:`pegame.visibility.outlines.visibility_outlines`)
+OUTLINE_RAYS = 64
 
 
 def map_message(grid: OccupancyGrid) -> dict[str, Any]:
@@ -48,8 +53,11 @@ def map_message(grid: OccupancyGrid) -> dict[str, Any]:
     }
 
 
-def frame(tick: Tick, show: tuple[str, ...]) -> dict[str, Any]:
-    """The page's frame of ``tick`` with what ``show`` allows (module docstring)."""
+def frame(
+    tick: Tick, show: tuple[str, ...], context: Context, sent: float | None = None
+) -> dict[str, Any]:
+    """The page's frame of ``tick`` with what ``show`` allows (module docstring), handed
+    over at ``sent`` (ms since the epoch; now when None)."""
     e = tick.evader
     out: dict[str, Any] = {
         "type": "frame",
@@ -60,6 +68,16 @@ def frame(tick: Tick, show: tuple[str, ...]) -> dict[str, Any]:
     if "pursuer" in show or "cone" in show:
         pursuers = tick.team.pursuers if tick.team is not None else (tick.pursuer,)
         out["pursuers"] = [[p.x, p.y, p.theta] for p in pursuers]
+    if "cone" in show:
+        outlines = visibility_outlines(
+            context.grid,
+            [p.x for p in pursuers],
+            [p.y for p in pursuers],
+            [p.theta for p in pursuers],
+            context.camera,
+            OUTLINE_RAYS,
+        )
+        out["cones"] = np.round(outlines[:, :, :2].astype(float), 3).tolist()
     if "belief" in show:
         belief, shown = tick.belief, {}
         if belief.mean is not None:
@@ -68,7 +86,7 @@ def frame(tick: Tick, show: tuple[str, ...]) -> dict[str, Any]:
             step = -(-len(belief.particles) // MAX_PARTICLES)  # ceil: at most MAX_PARTICLES
             shown["particles"] = np.round(belief.particles[::step, :2], 3).tolist()
         out["belief"] = shown
-    out["sent"] = now_ms()
+    out["sent"] = now_ms() if sent is None else sent
     return out
 
 
@@ -114,8 +132,9 @@ class PlayRecorder(Recorder):
         )
 
     def log(self, tick: Tick) -> None:
+        handed = now_ms()  # the page's tick-to-frame latency counts the recording too
         self.inner.log(tick)
-        self.session.publish_frame(frame(tick, self.session.show))
+        self.session.publish_frame(frame(tick, self.session.show, self.context, handed))
 
     def finish(self, result: dict[str, Any]) -> None:
         self.inner.finish(result)

@@ -11,10 +11,11 @@ from PIL import Image
 from pegame import registry
 from pegame.api import Recorder, Tick
 from pegame.errors import ConfigError
-from pegame.play.recorder import MAX_PARTICLES, PlayRecorder, frame, map_message
+from pegame.play.recorder import MAX_PARTICLES, OUTLINE_RAYS, PlayRecorder, frame, map_message
 from pegame.play.session import Session, activate
 from pegame.testing import small_context, small_map
 from pegame.types import STOP, Belief, Plan, Pose, SensorFrame
+from pegame.visibility.outlines import NEAR_ARC_POINTS
 
 
 def tick(belief: Belief) -> Tick:
@@ -37,14 +38,21 @@ def tick(belief: Belief) -> Tick:
 def test_a_frame_shows_the_pursuer_and_belief_only_when_allowed():
     particles = np.random.default_rng(0).uniform(0, 3, size=(1000, 3))
     t = tick(Belief((2.0, 1.4), particles=particles, weights=np.full(1000, 1e-3)))
-    hidden = frame(t, ())
+    hidden = frame(t, (), small_context())
     assert hidden["evader"] == [2.0, 1.5, -1.0]
     assert "pursuers" not in hidden and "belief" not in hidden
-    assert frame(t, ("cone",))["pursuers"] == [[1.0, 1.0, 0.5]]
-    shown = frame(t, ("pursuer", "belief"))
+    cone = frame(t, ("cone",), small_context())
+    assert cone["pursuers"] == [[1.0, 1.0, 0.5]]
+    (outline,) = cone["cones"]  # the pursuer's view, walls hiding what is behind them
+    assert len(outline) == OUTLINE_RAYS + NEAR_ARC_POINTS + 1 and outline[0] == outline[-1]
+    camera = small_context().camera
+    reach = [((x - 1.0) ** 2 + (y - 1.0) ** 2) ** 0.5 for x, y in outline]
+    assert max(reach) <= camera.far + 1e-3 and min(reach) >= camera.near - 1e-3
+    assert "cones" not in frame(t, ("pursuer",), small_context())
+    shown = frame(t, ("pursuer", "belief"), small_context())
     assert shown["belief"]["mean"] == [2.0, 1.4]
     assert 0 < len(shown["belief"]["particles"]) <= MAX_PARTICLES
-    assert frame(tick(Belief(None)), ("belief",))["belief"] == {}
+    assert frame(tick(Belief(None)), ("belief",), small_context())["belief"] == {}
 
 
 def test_the_map_image_has_a_pixel_per_cell_with_the_highest_row_on_top():

@@ -117,20 +117,22 @@ function drawAgent(view, pose, radius, colour) {
   ctx.stroke();
 }
 
-function drawCone(view, pose, camera) {
-  const [cx, cy] = view.toCanvas(pose[0], pose[1]);
-  const far = view.metres(camera.far);
-  const near = view.metres(camera.near);
-  const a0 = -pose[2] - camera.fov / 2;
-  const a1 = -pose[2] + camera.fov / 2;
+// A pursuer's view: the outline of its visibility region (walls hide what is behind
+// them), filled; pegame.conePoint is a point inside it, on the optical axis.
+function drawCone(view, outline, pose, camera) {
   ctx.fillStyle = "rgba(229, 57, 53, 0.28)";
   ctx.beginPath();
-  ctx.arc(cx, cy, far, a0, a1);
-  ctx.arc(cx, cy, near, a1, a0, true);
+  outline.forEach(([x, y], i) => {
+    const [cx, cy] = view.toCanvas(x, y);
+    if (i === 0) ctx.moveTo(cx, cy);
+    else ctx.lineTo(cx, cy);
+  });
   ctx.closePath();
   ctx.fill();
-  const mid = (near + far) / 2;
-  pegame.conePoint = [cx + mid * Math.cos(pose[2]), cy - mid * Math.sin(pose[2])];
+  const axis = outline[Math.floor((outline.length - 9) / 2)]; // the middle ray's end
+  const reach = Math.hypot(axis[0] - pose[0], axis[1] - pose[1]);
+  const mid = (camera.near + Math.max(reach, camera.near)) / 2;
+  pegame.conePoint = view.toCanvas(pose[0] + mid * Math.cos(pose[2]), pose[1] + mid * Math.sin(pose[2]));
   pegame.conesDrawn += 1;
 }
 
@@ -159,9 +161,9 @@ function draw(frame) {
       ctx.lineWidth = 1;
     }
   }
-  for (const pose of frame.pursuers || []) {
-    if (game.show.includes("cone")) drawCone(view, pose, game.camera);
-    if (game.show.includes("pursuer")) drawAgent(view, pose, game.pursuer_radius, "#e53935");
+  (frame.cones || []).forEach((outline, i) => drawCone(view, outline, frame.pursuers[i], game.camera));
+  if (game.show.includes("pursuer")) {
+    for (const pose of frame.pursuers || []) drawAgent(view, pose, game.pursuer_radius, "#e53935");
   }
   drawAgent(view, frame.evader, game.evader.radius, "#43a047");
   clock.textContent = `${frame.time.toFixed(1)} / ${game.t_max} s`;
