@@ -4,6 +4,7 @@ build needs nothing from the network."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import subprocess
@@ -50,6 +51,20 @@ def test_the_results_pages_tables_are_those_generated_from_the_committed_tables(
         timeout=60,
     )
     assert done.returncode == 0, done.stderr
+
+
+def test_the_performance_history_page_is_generated_from_its_records():
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "docs" / "performance" / "history.py"), "--check"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    page = (ROOT / "docs" / "explanation" / "performance-history.md").read_text()
+    records = (ROOT / "docs" / "performance" / "history.jsonl").read_text().splitlines()
+    assert records  # a row per record, named by its commit
+    assert all(f"`{json.loads(line)['commit'][:7]}`" in page for line in records)
 
 
 def test_a_result_quoted_by_hand_in_a_results_page_is_caught(tmp_path):
