@@ -86,10 +86,13 @@ def served(overrides: Sequence[str], out: Path, games: int = 1) -> Iterator[tupl
     )
     assert process.stdout is not None
     try:
-        line = process.stdout.readline()
-        if "http://" not in line:
-            rest = process.stdout.read()
-            raise RuntimeError(f"python -m pegame.play did not serve: {line}{rest}")
+        before = []  # what the command printed before its URL (a cold kernel cache's notice)
+        for line in process.stdout:
+            if "in a browser" in line:
+                break
+            before.append(line)
+        else:
+            raise RuntimeError(f"python -m pegame.play did not serve: {''.join(before)}")
         yield process, line.split("open ", 1)[1].split()[0]
     finally:
         if process.poll() is None:
