@@ -29,6 +29,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from hydra.errors import HydraException
 from omegaconf import DictConfig, OmegaConf, open_dict
 from omegaconf.errors import OmegaConfBaseException
 
@@ -183,7 +184,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except PegameError as exc:
         print(f"pegame: error: {exc}", file=sys.stderr)
         return sweep.BAD_INPUT
-    except OmegaConfBaseException as exc:  # a malformed override Hydra could not parse
+    except (HydraException, OmegaConfBaseException) as exc:  # an override Hydra refused
         print(f"pegame: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return sweep.BAD_INPUT
 

@@ -33,6 +33,8 @@ def test_the_person_is_the_evader_and_a_recorder_choice_is_what_the_page_tees_to
         (["evader=smart"], "Allowed: human"),
         (["game.trials=2"], "game.trials"),
         (["env=nowhere"], "env"),
+        (["game.t_max=[1"], "input '[1'"),
+        (["--host", "192.0.2.1"], "--host"),
     ],
 )
 def test_bad_input_is_one_paragraph_and_exit_2_before_serving(capsys, overrides, message):
