@@ -20,8 +20,9 @@ of its next game (reward 0, actions ignored). All games have the same length, so
 end and restart together when started together.
 
 What differs from the single env: the batched game plays the configurations that
-:func:`pegame.vector.game.check_playable` allows, and its means and path lengths are
-summed tick by tick (:mod:`pegame.vector.metrics`).
+:func:`pegame.vector.game.check_playable` allows, its means and path lengths are
+summed tick by tick (:mod:`pegame.vector.metrics`), and its measures keep no loss causes
+(``loss_causes`` None).
 """
 
 from __future__ import annotations
