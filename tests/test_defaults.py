@@ -100,7 +100,7 @@ def installed(monkeypatch):
 
 
 def test_every_registered_plugin_has_one_config_file_and_every_file_a_plugin():
-    assert len(OPTIONS) == 23  # 19 built in, pybullet + segmentation, vision, spinner
+    assert len(OPTIONS) == 24  # 19 built in, pybullet + segmentation, vision + person, spinner
     registered = {(config_root(dist) / group / f"{name}.yaml") for dist, group, name, _ in OPTIONS}
     files = {
         path
