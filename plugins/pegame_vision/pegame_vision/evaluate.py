@@ -67,11 +67,16 @@ class _Judge(Detector):
         sim: PybulletSimulator,
         max_range: float,
         min_visible: float,
+        measure_visible: bool = False,
     ) -> None:
         super().__init__(reference.config, reference.context, reference.rng)
         self.reference, self.vision, self.sim = reference, vision, sim
         self.max_range, self.min_visible = max_range, min_visible
+        self.measure_visible = measure_visible  # visible fraction of every frame with the evader
         self.rows: list[Row] = []
+        #: per row, the frame's time (s), the camera's pose and the evader's visible fraction
+        #: (None: not measured)
+        self.views: list[tuple[float, Pose, float | None]] = []
         self.latencies: list[float] = []  # s, the detector under test's detect per new frame
         self.cpu: list[float] = []  # s of this process's CPU time in the same calls
         self._frame: SensorFrame | None = None
@@ -91,16 +96,21 @@ class _Judge(Detector):
             self.latencies.append(time.perf_counter() - start)
             self.cpu.append(time.process_time() - cpu)
             self._frame = frame
+        visible = None
+        if truth is not None and self.measure_visible:
+            visible = self.sim.evader_visible_fraction()
         if truth is None:
             kind = "negative"
         elif (
             frame.camera_pose.distance_to(evader) <= self.max_range
-            and self.sim.evader_visible_fraction() >= self.min_visible
+            and (visible if visible is not None else self.sim.evader_visible_fraction())
+            >= self.min_visible
         ):
             kind = "positive"
         else:
             kind = "ignored"
         self.rows.append((kind, truth, seen, evader))
+        self.views.append((frame.time, frame.camera_pose, visible))
         return truth
 
 
@@ -120,37 +130,54 @@ def evaluate(
     over S-S games on ``env``, one per seed, ``t_max`` s each, the game config changed by
     ``overrides`` (e.g. ``sim.camera_tilt=0``); see the module docstring. The scores are
     named ``<detector>_precision`` and so on."""
+    rows, latencies, cpu = [], [], []
+    for seed in seeds:
+        judge = judged_game(env, seed, t_max, detector, vision, overrides, max_range, min_visible)
+        rows += judge.rows
+        latencies += judge.latencies
+        cpu += judge.cpu
+    return _score(rows, iou_threshold, latencies, cpu, detector)
+
+
+def judged_game(
+    env: str,
+    seed: int,
+    t_max: float,
+    detector: str,
+    vision: Mapping[str, Any] | None = None,
+    overrides: Iterable[str] = (),
+    max_range: float = 4.0,
+    min_visible: float = 0.3,
+    measure_visible: bool = False,
+) -> _Judge:
+    """One S-S game on ``env`` driven by ``detector=segmentation`` with ``detector`` (its
+    parameters in ``vision``) judged beside it; the judge holds the game's rows."""
     from pegame_pybullet.sim import PybulletSimulator
 
-    vision_cls = registry.load("detector", detector)
-    vision_config = registry.make_config("detector", vision_cls, dict(vision or {}))
-    rows, latencies, cpu = [], [], []
+    tested_cls = registry.load("detector", detector)
+    tested_config = registry.make_config("detector", tested_cls, dict(vision or {}))
+    game = Game(
+        compose(
+            [
+                "sim=pybullet",
+                "detector=segmentation",
+                "pursuer=smart",
+                "evader=smart",
+                "recorder=none",
+                f"env={env}",
+                f"game.t_max={t_max}",
+                f"game.seed={seed}",
+                *overrides,
+            ]
+        )
+    )
+    tested = tested_cls(tested_config, game.context, np.random.default_rng(seed))
+    sim = PybulletSimulator.narrow(game.plugins.sim)  # the games' sim=pybullet
+    judge = _Judge(game.plugins.detector, tested, sim, max_range, min_visible, measure_visible)
+    game.plugins = replace(game.plugins, detectors=((judge,),))
     with tempfile.TemporaryDirectory() as out:
-        for seed in seeds:
-            game = Game(
-                compose(
-                    [
-                        "sim=pybullet",
-                        "detector=segmentation",
-                        "pursuer=smart",
-                        "evader=smart",
-                        "recorder=none",
-                        f"env={env}",
-                        f"game.t_max={t_max}",
-                        f"game.seed={seed}",
-                        *overrides,
-                    ]
-                )
-            )
-            tested = vision_cls(vision_config, game.context, np.random.default_rng(seed))
-            sim = PybulletSimulator.narrow(game.plugins.sim)  # the games' sim=pybullet
-            judge = _Judge(game.plugins.detector, tested, sim, max_range, min_visible)
-            game.plugins = replace(game.plugins, detectors=((judge,),))
-            game.play(out)
-            rows += judge.rows
-            latencies += judge.latencies
-            cpu += judge.cpu
-    return _score(rows, iou_threshold, latencies, cpu, detector)
+        game.play(out)
+    return judge
 
 
 def _score(
