@@ -316,3 +316,37 @@ def test_the_scenario_checks_what_needs_the_camera_and_the_control_rate_before_a
 
     with pytest.raises(ConfigError, match=f"detector.{key}"):
         Scenario(compose(["env=enclosed", *overrides]))
+
+
+def _pipeline_reference(rate, latency, period, times, capture):
+    """The pipeline's rate and latency in plain Python (a deque, the model before its
+    kernels): the result held at each of ``times``."""
+    from collections import deque
+
+    first, captures, pending, held, out = None, 0, deque(), None, []
+    for time in times:
+        first = time if first is None else first
+        if rate is None or time >= first + captures * period - 1e-9:
+            pending.append((time + latency, capture(time)))
+            while rate is not None and first + captures * period <= time + 1e-9:
+                captures += 1
+        while pending and pending[0][0] <= time + 1e-9:
+            held = pending.popleft()[1]
+        out.append(held)
+    return out
+
+
+@pytest.mark.parametrize(
+    ("hz", "rate", "latency"),
+    [(10.0, 1.0, 0.1), (10.0, 3.0, 0.25), (10.0, None, 0.3), (7.0, 25.0, 0.05), (10.0, 0.7, 2.0)],
+)
+def test_the_pipeline_kernels_deliver_what_the_plain_pipeline_does(hz, rate, latency):
+    """The kernels on a batch of one, skipping the ticks between events, hold and deliver
+    the results of a deque of (delivery time, result), tick for tick."""
+    model = perception(hz, rate=rate, latency=latency)
+    times = [k / hz for k in range(400)]
+    want = _pipeline_reference(rate, latency, model.period, times, lambda t: round(t * hz))
+    got = [model.deliver(t, ORIGIN, lambda t=t: round(t * hz)) for t in times]
+    assert got == want and len(set(got)) > 10
+    model.reset()  # a new game starts empty
+    assert model.deliver(0.0, ORIGIN, lambda: 0) == (0 if latency == 0 else None)
