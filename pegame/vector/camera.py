@@ -328,19 +328,27 @@ def detect(
 
 
 @njit(cache=True, inline="always")
-def _deliver(
-    world: World, rules: Rules, state: BatchState, game: int, time: float, radius: float
-) -> bool:
-    """The perception pipeline's tick of ``game`` at ``time`` s: a capture when a frame is
-    due (into state.capture), put in flight, and the result delivered by then into
-    state.detected and state.detection (the held one stays when none is). Returns whether
-    the evader's centre is in view."""
+def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
+    """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
+    pursuer observation's memory of the last detection (``PursuerFeatures.remember``).
+    When the perception pipeline runs, a frame is captured only when one is due (into
+    state.capture), put in flight, and the result delivered by then goes into
+    state.detected and state.detection (the held one stays when none is); else the
+    capture is the detection. The caller inlines it once per game, so that the
+    NamedTuples' arrays are taken out once (and :func:`detect` is inlined once)."""
     frame, blocked, values = world.frame, world.blocked, world.sight_values
-    camera, perception = rules.camera, rules.perception
-    poses = state.poses
+    camera, perception, radius = rules.camera, rules.perception, rules.bodies[EVADER, RADIUS]
+    poses, detected, detection = state.poses, state.detected, state.detection
+    time = state.steps[game] * rules.control_dt
+    pipeline = perception[PIPELINE] != 0.0
     period, rated = perception[PERIOD], perception[RATED] != 0.0
-    due, _ = frame_due(state.pipeline, game, time, period, rated)
+    due = True
+    if pipeline:
+        due, _ = frame_due(state.pipeline, game, time, period, rated)
+    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
+    ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
     if due:
+        out, rows = (state.captured, state.capture) if pipeline else (detected, detection)
         centre = detect(
             frame,
             blocked,
@@ -351,54 +359,23 @@ def _deliver(
             poses,
             state.draws,
             state.drawn,
-            state.captured,
-            state.capture,
+            out,
+            rows,
             game,
         )
     else:
-        px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
-        ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
         centre = point_in_view(frame, blocked, values, camera, px, py, ptheta, ex, ey)
-    latency = perception[LATENCY]
-    slot_in, slot_out, _ = deliver_frame(state.pipeline, game, time, period, rated, latency, due)
-    if slot_in >= 0:
-        state.in_flight_detected[game, slot_in] = state.captured[game]
-        state.in_flight[game, slot_in, :] = state.capture[game, :]
-    if slot_out >= 0:
-        state.detected[game] = state.in_flight_detected[game, slot_out]
-        state.detection[game, :] = state.in_flight[game, slot_out, :]
-    return centre
-
-
-@njit(cache=True, inline="always")
-def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
-    """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
-    pursuer observation's memory of the last detection (``PursuerFeatures.remember``).
-    The caller inlines it once per game, so that the NamedTuples' arrays are taken out
-    once."""
-    frame, blocked, values = world.frame, world.blocked, world.sight_values
-    camera, radius = rules.camera, rules.bodies[EVADER, RADIUS]
-    poses, detected, detection = state.poses, state.detected, state.detection
-    time = state.steps[game] * rules.control_dt
-    if rules.perception[PIPELINE] != 0.0:
-        centre = _deliver(world, rules, state, game, time, radius)
-    else:
-        centre = detect(
-            frame,
-            blocked,
-            values,
-            camera,
-            rules.perception,
-            radius,
-            poses,
-            state.draws,
-            state.drawn,
-            detected,
-            detection,
-            game,
+    if pipeline:
+        latency = perception[LATENCY]
+        slot_in, slot_out, _ = deliver_frame(
+            state.pipeline, game, time, period, rated, latency, due
         )
-    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
-    ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
+        if slot_in >= 0:
+            state.in_flight_detected[game, slot_in] = state.captured[game]
+            state.in_flight[game, slot_in, :] = state.capture[game, :]
+        if slot_out >= 0:
+            detected[game] = state.in_flight_detected[game, slot_out]
+            detection[game, :] = state.in_flight[game, slot_out, :]
     state.in_view[game] = body_in_view(
         frame, blocked, values, camera, px, py, ptheta, ex, ey, radius, centre
     )
