@@ -152,18 +152,18 @@ def main(argv: list[str] | None = None) -> Path:
         "overrides", nargs="*", help="game config overrides, e.g. sim.camera_tilt=0"
     )
     args = parser.parse_args(argv)
+    try:  # the commit the games are played at (read first: others may commit meanwhile)
+        commit = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        commit = "unknown"
     cpu: list[float] = []
     records = frames(args.detector, args.envs, range(args.seeds), args.t_max, args.overrides, cpu)
     rows = profile_rows(records, cpu)
     csv = "variable,low,high,frames,p_detect\n" + "".join(
         ",".join(_cell(v) for v in row) + "\n" for row in rows
     )
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
-        ).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        commit = "unknown"
     command = " ".join(
         ["python -m pegame_vision.profile", *(sys.argv[1:] if argv is None else argv)]
     )
