@@ -348,6 +348,13 @@ def goals() -> str:
     return "\n".join(lines)
 
 
+def goals_margin() -> str:
+    """The non-inferiority margin of the 'no worse' goals (``goals.csv``), in points."""
+    margins = {float(r["margin"]) for r in rows("round_robin/goals.csv") if r["margin"]}
+    (margin,) = margins
+    return percent(margin, 0)
+
+
 def round_robin_games() -> str:
     table = rows("round_robin/table.csv")
     return f"{sum(int(r['n']) for r in table)} games in {len(table)} cells"
@@ -358,7 +365,7 @@ PAGES: dict[str, tuple[dict[str, Callable[[], str]], dict[str, Callable[[], str]
     "paper-table1.md": ({"table1": table1}, PAPER_TABLE1_VALUES),
     "strategies.md": (
         {"goals": goals, "round_robin": round_robin},
-        {"round_robin_games": round_robin_games},
+        {"round_robin_games": round_robin_games, "goals_margin": goals_margin},
     ),
 }
 

@@ -12,9 +12,12 @@ Writes into --out:
 - ``heatmap_<map>.png``: mean tracking rate, pursuers x evaders, one panel per
   conditions and speed ratio;
 - ``goals.md`` and ``goals.csv``: the paired tests behind issue 18's goals, cell by cell
-  (map x speed ratio), on the seeds both sides played (same seed, same spawn poses): the
-  one-sided Wilcoxon signed-rank test with Pratt's zeros (:mod:`pegame.report.paired`),
-  Holm-Bonferroni corrected across the nine cells of each goal and conditions;
+  (map x speed ratio), on the seeds both sides played (same seed, same spawn poses),
+  Holm-Bonferroni corrected across the nine cells of each goal and conditions: for
+  "higher" and "lower" the one-sided Wilcoxon signed-rank test with Pratt's zeros
+  (:mod:`pegame.report.paired`); for "no worse" the non-inferiority test at the margin
+  ``--margin`` (default 0.02, 2 percentage points; :mod:`pegame.report.noninferiority`:
+  H0 mean(x - y) <= -margin, one-sided paired bootstrap), issue 29;
 - ``summary.md``: the mean tracking rates as Markdown tables;
 - ``provenance.md``: the commits, dirty flags, package versions and game counts read
   from the games' own result lines.
@@ -35,7 +38,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from pegame.report.load import load_sweep
-from pegame.report.paired import KEYS, by_seed, paired_test
+from pegame.report.noninferiority import decide, noninferiority_test
+from pegame.report.paired import by_seed, paired_test
 from pegame.report.statistics import ALPHA, describe, holm
 
 CONDITIONS = ("default", "paper_conditions")
@@ -45,9 +49,12 @@ MAPS = ("hall", "enclosed", "brick")
 RATIOS = (0.5, 1.0, 2.0)
 
 #: (goal, conditions, (pursuer, evader) x, (pursuer, evader) y, alternative about x - y,
-#: what "met" means). "greater"/"less" goals are met where the Holm-corrected p < alpha;
-#: "no lower" goals where x is not significantly lower than y (Holm-corrected p >= alpha
-#: of the one-sided test x < y).
+#: what "met" means). "greater"/"less" goals are met where the Holm-corrected p of the
+#: one-sided Wilcoxon test < alpha; "noninferior" ("no worse") goals where x is shown no
+#: worse than y by more than the margin (Holm-corrected p of the non-inferiority test
+#: <= alpha). Until issue 29 "no worse" was met where the test of x < y did not reject,
+#: which passed a shortfall whose interval lay wholly below zero.
+MARGIN = 0.02  # issue 29's margin, stated before the goals were re-tested
 GOALS = [
     (
         "pursuer beats smart vs smart evader",
@@ -62,24 +69,24 @@ GOALS = [
         "default",
         ("anticipating", "smart"),
         ("smart", "smart"),
-        "less",
-        "no lower",
+        "noninferior",
+        "no worse",
     ),
     (
         "pursuer no worse vs random evader",
         "paper_conditions",
         ("anticipating", "random"),
         ("smart", "random"),
-        "less",
-        "no lower",
+        "noninferior",
+        "no worse",
     ),
     (
         "pursuer no worse vs random evader",
         "default",
         ("anticipating", "random"),
         ("smart", "random"),
-        "less",
-        "no lower",
+        "noninferior",
+        "no worse",
     ),
     (
         "evader beats smart vs smart pursuer",
@@ -263,7 +270,22 @@ def write_summary(means: dict, path: Path) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
-def goal_tests(cells: dict) -> list[dict]:
+def goal_test(a: list[dict], b: list[dict], alternative: str, margin: float) -> dict:
+    """One cell's test of x (games ``a``) against y (``b``) on common seeds: the one-sided
+    Wilcoxon signed-rank test for 'greater'/'less', the non-inferiority test at ``margin``
+    for 'noninferior' (then with the two-sided bootstrap CI of the mean difference)."""
+    x, y = by_seed(a), by_seed(b)
+    if alternative != "noninferior":
+        return {**paired_test(x, y, alternative), "margin": None, "lower_bound": None}
+    two_sided = paired_test(x, y, "two-sided")
+    return {
+        **{k: two_sided[k] for k in ("ci_low", "ci_high", "zero_differences")},
+        **noninferiority_test(x, y, margin),
+        "margin": margin,
+    }
+
+
+def goal_tests(cells: dict, margin: float = MARGIN) -> list[dict]:
     """One row per goal, conditions and cell, Holm-corrected per goal and conditions."""
     rows = []
     for goal, conditions, x, y, alternative, meaning in GOALS:
@@ -272,7 +294,7 @@ def goal_tests(cells: dict) -> list[dict]:
             for ratio in RATIOS:
                 a = cells.get((conditions, *x, name, ratio), [])
                 b = cells.get((conditions, *y, name, ratio), [])
-                test = paired_test(by_seed(a), by_seed(b), alternative)
+                test = goal_test(a, b, alternative, margin)
                 family.append(
                     {
                         "goal": goal,
@@ -286,66 +308,108 @@ def goal_tests(cells: dict) -> list[dict]:
                         **test,
                     }
                 )
-        tested = [r for r in family if r["p"] is not None]
-        for row, p in zip(tested, holm([r["p"] for r in tested])):
-            row["p_holm"] = p
-            significant = p < ALPHA
-            row["met"] = (not significant) if meaning == "no lower" else significant
-        for row in family:
-            row.setdefault("p_holm", None)
-            row.setdefault("met", None)
+        if alternative == "noninferior":
+            decide(family)
+            for row in family:
+                row["met"] = row.pop("noninferior")
+        else:
+            tested = [r for r in family if r["p"] is not None]
+            for row, p in zip(tested, holm([r["p"] for r in tested])):
+                row.update(p_holm=p, met=p < ALPHA)
+            for row in family:
+                row.setdefault("p_holm", None)
+                row.setdefault("met", None)
         rows.extend(family)
     return rows
 
 
-def write_goals(rows: list[dict], out: Path) -> None:
-    keys = ["goal", "conditions", "x", "y", "alternative", "map", "speed_ratio", *KEYS]
-    keys += ["p_holm", "met"]
+GOAL_KEYS = [
+    "goal",
+    "conditions",
+    "x",
+    "y",
+    "alternative",
+    "margin",
+    "map",
+    "speed_ratio",
+    "n_pairs",
+    "mean_x",
+    "mean_y",
+    "mean_difference",
+    "ci_low",
+    "ci_high",
+    "lower_bound",
+    "zero_differences",
+    "W",
+    "rank_biserial",
+    "p",
+    "p_holm",
+    "met",
+]
+
+
+def points(value: float) -> str:
+    """A difference in percentage points."""
+    return f"{100 * value:+.1f}"
+
+
+def goal_line(r: dict) -> str:
+    """One cell of a goal's table."""
+    head = f"| {r['map']} | {r['speed_ratio']:g} | {r['n_pairs']} | "
+    if r["p"] is None:
+        return head + " | ".join(["–"] * 6) + " | not tested |"
+    means = f"{100 * r['mean_x']:.1f}% | {100 * r['mean_y']:.1f}% | "
+    difference = f"{points(r['mean_difference'])} pp [{points(r['ci_low'])}, {points(r['ci_high'])}]"
+    tail = f"{r['p']:.3g} | {r['p_holm']:.3g} | {'yes' if r['met'] else 'no'} |"
+    if r["margin"] is None:
+        return head + means + f"{difference} | {r['W']:g} | " + tail
+    return head + means + f"{difference} | {points(r['lower_bound'])} pp | " + tail
+
+
+def write_goals(rows: list[dict], out: Path, margin: float = MARGIN) -> None:
     with (out / "goals.csv").open("w", newline="") as f:
-        writer = csv.DictWriter(f, keys, extrasaction="ignore")
+        writer = csv.DictWriter(f, GOAL_KEYS, extrasaction="ignore")
         writer.writeheader()
         writer.writerows(rows)
     lines = [
         "# The goals of issue 18, cell by cell",
         "",
-        "Paired on common seeds (same seed, same spawn poses): one-sided Wilcoxon "
-        "signed-rank test with Pratt's zeros of x - y (scipy.stats.wilcoxon), "
-        "Holm-Bonferroni corrected across the nine cells of each goal and conditions, "
-        f"alpha = {ALPHA}; mean paired difference in percentage points with its "
-        "percentile-bootstrap CI over seeds. 'higher'/'lower' goals are met where the "
-        "corrected p is below alpha; 'no lower' goals where x is not significantly "
-        "lower than y (corrected p of the one-sided test x < y at least alpha).",
+        "Paired on common seeds (same seed, same spawn poses), Holm-Bonferroni corrected "
+        f"across the nine cells of each goal and conditions, alpha = {ALPHA}; mean paired "
+        "difference x - y in percentage points with its two-sided 95% percentile-bootstrap "
+        "CI over seeds. 'higher'/'lower' goals: one-sided Wilcoxon signed-rank test with "
+        "Pratt's zeros (scipy.stats.wilcoxon), met where the corrected p is below alpha. "
+        f"'no worse' goals (issue 29): non-inferiority at a margin of {100 * margin:g} "
+        f"percentage points, H0 mean(x - y) <= -{100 * margin:g} pp against H1 mean(x - y) "
+        f"> -{100 * margin:g} pp, by the one-sided paired percentile bootstrap of the mean "
+        "difference (10,000 resamples, fixed seed; p = (1 + resample means at or below "
+        "the margin) / 10,001, pegame.report.noninferiority), met where the corrected p is "
+        "at most alpha; the one-sided 95% lower bound is shown. Before issue 29 a 'no "
+        "lower' goal was met wherever a one-sided test of x < y did not reject.",
         "",
     ]
     seen = []
     for row in rows:
         head = (row["goal"], row["conditions"])
-        if head not in seen:
-            seen.append(head)
-            family = [r for r in rows if (r["goal"], r["conditions"]) == head]
-            met = sum(bool(r["met"]) for r in family)
-            lines += [
-                "",
-                f"## {row['goal']} ({row['conditions']}): {row['x']} against "
-                f"{row['y']}, goal '{row['meaning']}': met in {met} of {len(family)} cells",
-                "",
-                "| map | v_p/v_e | pairs | x mean | y mean | x - y [CI] | W | p | p (Holm) | met |",
-                "|---|---|---|---|---|---|---|---|---|---|",
-            ]
-            for r in family:
-                if r["p"] is None:
-                    lines.append(
-                        f"| {r['map']} | {r['speed_ratio']:g} | {r['n_pairs']} | – | – "
-                        "| – | – | – | – | not tested |"
-                    )
-                    continue
-                lines.append(
-                    f"| {r['map']} | {r['speed_ratio']:g} | {r['n_pairs']} | "
-                    f"{100 * r['mean_x']:.1f}% | {100 * r['mean_y']:.1f}% | "
-                    f"{100 * r['mean_difference']:+.1f} pp [{100 * r['ci_low']:+.1f}, "
-                    f"{100 * r['ci_high']:+.1f}] | {r['W']:g} | {r['p']:.3g} | "
-                    f"{r['p_holm']:.3g} | {'yes' if r['met'] else 'no'} |"
-                )
+        if head in seen:
+            continue
+        seen.append(head)
+        family = [r for r in rows if (r["goal"], r["conditions"]) == head]
+        met = sum(bool(r["met"]) for r in family)
+        meaning = row["meaning"] + (
+            f" by more than {100 * margin:g} pp" if row["margin"] is not None else ""
+        )
+        statistic = "W" if row["margin"] is None else "one-sided 95% lower bound"
+        lines += [
+            "",
+            f"## {row['goal']} ({row['conditions']}): {row['x']} against "
+            f"{row['y']}, goal '{meaning}': met in {met} of {len(family)} cells",
+            "",
+            f"| map | v_p/v_e | pairs | x mean | y mean | x - y [CI] | {statistic} | p | "
+            "p (Holm) | met |",
+            "|---|---|---|---|---|---|---|---|---|---|",
+            *(goal_line(r) for r in family),
+        ]
     (out / "goals.md").write_text("\n".join(lines) + "\n")
 
 
@@ -381,13 +445,19 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("sweeps", type=Path, help="run.sh's OUT directory")
     parser.add_argument("--out", type=Path, default=Path("docs/round_robin"))
+    parser.add_argument(
+        "--margin",
+        type=float,
+        default=MARGIN,
+        help="the non-inferiority margin of the 'no worse' goals, a fraction (default 0.02)",
+    )
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     cells, records = load(args.sweeps)
     means = write_table(cells, args.out / "table.csv")
     heat_maps(means, args.out)
     write_summary(means, args.out / "summary.md")
-    write_goals(goal_tests(cells), args.out)
+    write_goals(goal_tests(cells, args.margin), args.out, args.margin)
     write_provenance(records, cells, args.out)
 
 

@@ -5,23 +5,21 @@ ratio v_p/v_e)?
   *Indagationes Mathematicae* 14, 1952; Jonckheere, *Biometrika* 41, 1954). J counts, over
   every pair of groups i < j and every pair of observations (a from group i, b from group
   j), 1 where b > a and 1/2 where b = a. Under H0 (one distribution for all groups) its mean
-  is (N^2 - sum n_i^2) / 4 and its variance, corrected for ties (Hollander & Wolfe,
+  is `(N^2 - sum n_i^2) / 4` and its variance, corrected for ties (Hollander & Wolfe,
   *Nonparametric Statistical Methods*, 2nd ed. 1999, Sec. 6.2), is
-
-      [N(N-1)(2N+5) - sum n_i(n_i-1)(2n_i+5) - sum t(t-1)(2t+5)] / 72
-      + [sum n_i(n_i-1)(n_i-2)] [sum t(t-1)(t-2)] / [36 N(N-1)(N-2)]
-      + [sum n_i(n_i-1)] [sum t(t-1)] / [8 N(N-1)]
-
+  `(N(N-1)(2N+5) - sum n_i(n_i-1)(2n_i+5) - sum t(t-1)(2t+5)) / 72
+  + (sum n_i(n_i-1)(n_i-2)) (sum t(t-1)(t-2)) / (36 N(N-1)(N-2))
+  + (sum n_i(n_i-1)) (sum t(t-1)) / (8 N(N-1))`
   with t the sizes of the groups of tied values. p is the normal approximation's upper
   tail, P(Z >= z), z = (J - mean) / sd; ``tau`` = 2 J / M - 1 with M = sum_{i<j} n_i n_j, the
   share of concordant minus discordant pairs (+1: every later group above every earlier).
 - :func:`page`: the paired form, Page's L test (Page, *JASA* 58, 1963) of blocks (seeds:
   the same spawn poses at every level) x ordered treatments. Within each block the values
   are ranked (ties share their mean rank) and L = sum over blocks of sum_j j r_j. Under H0
-  each block's ranks are equally likely in any order, so E[L] = n k (k+1)^2 / 4 and, for a
-  block of ranks r, Var = [sum_j (j - (k+1)/2)^2] [sum_j (r_j - (k+1)/2)^2] / (k - 1): the
-  exact permutation variance, which is Page's n k^2 (k-1) (k+1)^2 / 144 without ties and
-  shrinks with them (a block tied at every level adds nothing). p = P(Z >= z).
+  each block's ranks are equally likely in any order, so `E(L) = n k (k+1)^2 / 4` and, for
+  a block of ranks r, `Var = (sum_j (j - (k+1)/2)^2) (sum_j (r_j - (k+1)/2)^2) / (k - 1)`:
+  the exact permutation variance, which is Page's `n k^2 (k-1) (k+1)^2 / 144` without ties
+  and shrinks with them (a block tied at every level adds nothing). p = P(Z >= z).
 
 Values are rounded to 12 decimals before ranking, as in :mod:`pegame.report.paired`, so
 float noise does not break ties. Both tests give p = 1 and z = None when the variance is
