@@ -83,9 +83,12 @@ def compare_cells(
     return rows
 
 
-def verdict(rows: list[dict[str, Any]], paired: bool = False) -> dict[str, Any]:
-    """holds / fails / partly over the tested cells, or not tested: of the Mann-Whitney
-    tests, or with ``paired`` of the Wilcoxon signed-rank tests (then tagged with ``test``)."""
+def verdict(
+    rows: list[dict[str, Any]], paired: bool = False, unit: str = "cells"
+) -> dict[str, Any]:
+    """holds / fails / partly over the tested cells (or other ``unit``), or not tested: of
+    the Mann-Whitney tests, or with ``paired`` of the Wilcoxon signed-rank tests (then
+    tagged with ``test``)."""
     outcomes = [row["paired"]["holds"] if paired else row["holds"] for row in rows]
     tested = [holds for holds in outcomes if holds is not None]
     k, n = sum(tested), len(tested)
@@ -95,7 +98,7 @@ def verdict(rows: list[dict[str, Any]], paired: bool = False) -> dict[str, Any]:
         "k": k,
         "n": n,
         "untested": len(rows) - n,
-        "text": UNTESTED if n == 0 else f"{word} (in {k} of {n} cells)",
+        "text": UNTESTED if n == 0 else f"{word} (in {k} of {n} {unit})",
     }
     return {**summary, "test": TEST_NAME} if paired else summary
 

@@ -106,7 +106,7 @@ def rises_with_speed(rates: Rates, seeded: Seeded | None) -> dict[str, Any]:
         tested = [t for t in tests if t["p"] is not None]
         for t, adjusted in zip(tested, holm([t["p"] for t in tested])):
             t.update(p_holm=adjusted, holds=adjusted <= ALPHA)
-    paired = {**verdict(rows, paired=True), "test": PAGE_NAME}
+    paired = {**verdict(rows, paired=True, unit="rows"), "test": PAGE_NAME}
     return {
         "id": "T1",
         "claim": "Tracking rises with the pursuer-to-evader speed ratio (the paper's Table 1: "
@@ -116,10 +116,11 @@ def rises_with_speed(rates: Rates, seeded: Seeded | None) -> dict[str, Any]:
         "approximation with the tie-corrected variance).",
         "rows": rows,
         "test": JT_NAME,
-        "summary": verdict(rows),
+        "summary": verdict(rows, unit="rows"),
         "summary_paired": paired,
         "by_pairing": {
-            p: verdict([r for r in rows if r["pairing"] == p])["text"] for p in pairings
+            p: verdict([r for r in rows if r["pairing"] == p], unit="environments")["text"]
+            for p in pairings
         },
     }
 

@@ -43,11 +43,11 @@ def test_a_rise_holds_a_fall_and_a_flat_line_do_not(tmp_path):
         assert fall["holds"] is False and fall["tau"] < -0.5 and fall["p"] > 0.99
         assert flat["holds"] is False and flat["paired"]["holds"] is False
         assert rise["means"] == pytest.approx([np.mean(cells[(m, r, "S-R")]) for r in RATIOS])
-    assert t1["by_pairing"]["S-R"] == "holds (in 2 of 2 cells)"
+    assert t1["by_pairing"]["S-R"] == "holds (in 2 of 2 environments)"
     assert t1["summary_paired"]["test"] == "Page's L on common seeds"
     assert t2["summary"]["verdict"] == "holds" and t2["summary_paired"]["verdict"] == "holds"
     md = (tmp_path / "out" / "hypotheses.md").read_text()
-    assert "# The paper's trends" in md and "## T1: partly (in 2 of 6 cells)" in md
+    assert "# The paper's trends" in md and "## T1: partly (in 2 of 6 rows)" in md
     assert "55.1 → 78.5 → 84.8%" in md  # the paper's hall S-R beside ours
     assert "21.8 → 23.9 → 17.6%" in md  # its 23.85%, halves up as the paper prints it
 
