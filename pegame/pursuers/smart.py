@@ -20,6 +20,16 @@ the pursuer follows a planned path to the detected position, as move_base would,
 of standing at the corner that its line of sight grazes (``detour``, not in the paper:
 false makes it stop and turn there).
 
+``track`` chooses between two readings of the paper's "We can compute the linear velocity
+required to keep at a certain distance from the evader" in 1 Hz nodes that "make use of
+move_base package for path planning given a goal location": ``servo`` (the default) is
+the reactive controller above, run at every control tick on the latest detection (held
+between the detector's results); ``goal`` sends each new detection to move_base as a
+goal: the point ``standoff`` m short of the detected position on the line from the
+pursuer, planned to once per new detection and followed at the control rate on the
+pursuer's own pose (pure pursuit, :class:`pegame.navigation.PathFollower`), turning to
+face the detected position once there (docs/trends/README.md).
+
 Searching (no detection): the pursuer plans from its pose to the estimator's estimate,
 the weighted mean of the particles (``observation.belief.mean``, map frame, m), and
 follows the path; it replans at every decision and at once when it loses the evader.
@@ -51,6 +61,8 @@ log = logging.getLogger(__name__)
 LOOKAHEAD_TIME = 0.5
 
 TRACK, SEARCH, SCAN = "track", "search", "scan"
+#: the ``track`` readings (module docstring)
+TRACKING = ("servo", "goal")
 
 
 class SmartPursuer(Pursuer):
@@ -68,12 +80,15 @@ class SmartPursuer(Pursuer):
         k_v: float = 1.0  # 1/s, forward speed per metre of depth error (depth - standoff)
         scan_rate: float = 1.0  # rad/s, turn rate when scanning in place
         detour: bool = True  # plan around an obstacle the line of sight grazes (false: wait)
+        track: str = "servo"  # servo: reactive (v, w) on each tick's detection; goal: each new
+        # detection is a move_base goal standoff m short of it, followed on odometry
 
         def __post_init__(self) -> None:
             super().__post_init__()
             require(self.standoff > 0, "standoff", "a positive distance in m", self.standoff)
             require(self.k_w > 0, "k_w", "a positive gain in rad/s", self.k_w)
             require(self.k_v > 0, "k_v", "a positive gain in 1/s", self.k_v)
+            require(self.track in TRACKING, "track", " or ".join(TRACKING), self.track)
             require(
                 self.scan_rate > 0,
                 "scan_rate",
@@ -93,6 +108,7 @@ class SmartPursuer(Pursuer):
         # The game starts with the evader in view, so the pursuer starts out tracking.
         self.mode = TRACK
         self._scan_sign = 1.0  # +1 CCW, -1 CW
+        self._goal_of: object = None  # the detection the ``goal`` reading's path was planned for
         self.follower.set_path(np.zeros((0, 2)))
 
     def decide(self, observation: PursuerObservation) -> Plan:
@@ -107,7 +123,10 @@ class SmartPursuer(Pursuer):
         estimate, then scan in place."""
         if observation.detection is not None:
             self.mode = TRACK
+            if self.config.track == "goal":
+                return self._track_goal(observation)
             return self._track(observation)
+        self._goal_of = None
         if self.mode == TRACK:
             # Just lost the evader: head for the estimate now rather than at the next decision.
             self._search(observation)
@@ -138,6 +157,30 @@ class SmartPursuer(Pursuer):
             blocked_ahead = v > 0 and self.config.detour
             return self._detour(observation, w) if blocked_ahead else Velocity(0.0, w)
         return Velocity(v, w)
+
+    def _track_goal(self, observation: PursuerObservation) -> Velocity:
+        """The ``goal`` reading: plan to the point ``standoff`` m short of a new detection's
+        position and follow the path on the pursuer's pose; at that point (or when it is
+        unreachable or the pursuer is already closer) turn in place to face the detection."""
+        detection, pose = observation.detection, observation.pose
+        assert detection is not None  # control tracks a detected evader only
+        gx, gy = detection.position
+        dx, dy = gx - pose.x, gy - pose.y
+        if detection is not self._goal_of:  # a new detection: a new goal for move_base
+            self._goal_of = detection
+            distance = math.hypot(dx, dy)
+            path = np.zeros((0, 2))
+            if distance > self.config.standoff:
+                scale = 1.0 - self.config.standoff / distance
+                result = self.planner.plan(
+                    (pose.x, pose.y), (pose.x + scale * dx, pose.y + scale * dy)
+                )
+                path = result.path if result.reachable else path
+            self.follower.set_path(path)
+        if not self.follower.done:
+            return self.follower.command(pose)
+        bearing = wrap_angle(math.atan2(dy, dx) - pose.theta)
+        return Velocity(0.0, clamp(self.follower.turn_gain * bearing, self.context.pursuer.w_max))
 
     def _detour(self, observation: PursuerObservation, w: float) -> Velocity:
         """Approaching is blocked (the line of sight grazes an obstacle): follow a planned

@@ -263,6 +263,7 @@ def test_unreachable_estimate_scans_toward_it(caplog):
         ({"k_w": -1.0}, "pursuer.k_w"),
         ({"k_v": 0.0}, "pursuer.k_v"),
         ({"scan_rate": -0.5}, "pursuer.scan_rate"),
+        ({"track": "chase"}, "pursuer.track"),
         ({"radius": 0.0}, "pursuer.radius"),
     ],
 )
@@ -281,3 +282,36 @@ def test_a_blocked_approach_detours_around_the_wall_end_unless_the_detour_is_off
     wait = make_pursuer(grid, detour=False).control(observe(pose, beyond))
     assert detour.w > 0.0  # it turns left, onto the planned path round the wall end
     assert wait.v == 0.0 and wait.w == pytest.approx(0.0)  # it stays, the evader centred
+
+
+# ------------------------------------------------------------------------ track=goal
+
+
+def test_goal_tracking_drives_to_the_standoff_point_of_a_detection_and_faces_it():
+    pursuer = make_pursuer(open_grid(), track="goal", standoff=1.5)
+    pose = Pose(1.0, 3.0, 0.5)  # facing away from the person by 0.5 rad
+    seen_at = Detection(BoundingBox(300.0, 100.0, 40.0, 200.0), 4.0, (5.0, 3.0))
+    pursuer.reset(pose)
+    for _ in range(200):  # the same (held) detection: one goal, followed on the pose
+        pose = step(pose, pursuer.control(observe(pose, seen_at)))
+    assert pursuer.mode == TRACK
+    assert math.hypot(pose.x - 5.0, pose.y - 3.0) == pytest.approx(1.5, abs=0.2)
+    assert abs(pose.theta) < 0.05  # faces the detected position
+    cmd = pursuer.control(observe(pose, seen_at))
+    assert cmd.v == 0.0
+
+
+def test_goal_tracking_replans_for_a_new_detection_only():
+    pursuer = make_pursuer(open_grid(), track="goal")
+    first = Detection(BoundingBox(300.0, 100.0, 40.0, 200.0), 4.0, (5.0, 3.0))
+    pursuer.control(observe(Pose(1.0, 3.0, 0.0), first))
+    path = pursuer.follower.path.copy()
+    pursuer.control(observe(Pose(1.2, 3.0, 0.0), first))
+    assert np.array_equal(pursuer.follower.path, path)  # held detection: the same goal
+    second = Detection(BoundingBox(300.0, 100.0, 40.0, 200.0), 4.0, (5.0, 5.0))
+    pursuer.control(observe(Pose(1.2, 3.0, 0.0), second))
+    assert not np.array_equal(pursuer.follower.path, path)
+
+
+def test_servo_is_the_default_tracking():
+    assert make_pursuer(open_grid()).config.track == "servo"
