@@ -35,3 +35,4 @@ run probe_scan_rate paper_conditions S-R $SMART_P $RANDOM_E pursuer.scan_rate=1.
 python docs/trends/readings.py "$OUT" --out docs/trends
 python docs/trends/servo.py --seeds "$N" --readings paper_conditions,held_commands,goal_tracking \
   --out docs/trends
+python docs/trends/trajectories.py --out docs/trends
