@@ -58,6 +58,13 @@ def servo_row(ticks: list, dt: float, v_max: float, w_max: float, fov: float) ->
                 s["lost"] += dt
                 step = math.hypot(nxt.pursuer.x - t.pursuer.x, nxt.pursuer.y - t.pursuer.y)
                 s["scan"] += dt * (step < 0.05 * v_max * dt)
+                mean = t.belief.mean
+                if mean is not None:
+                    s["estimated"] += dt
+                    s["error"] += dt * math.hypot(mean[0] - t.evader.x, mean[1] - t.evader.y)
+                    s["there"] += dt * (
+                        math.hypot(mean[0] - t.pursuer.x, mean[1] - t.pursuer.y) < 0.5
+                    )
             continue
         v, w = t.commands[0].v, t.commands[0].w
         moved = math.hypot(nxt.pursuer.x - t.pursuer.x, nxt.pursuer.y - t.pursuer.y) / dt
@@ -97,13 +104,15 @@ def servo_table(readings: dict[str, str], env: str, seeds: int) -> list[str]:
         "period following a fresh detection per radian of the evader's true bearing then "
         "(1 = turns onto it, > 2 = overshoots it by more than it was off). Losses per game "
         "by cause, seconds without a detection per loss (after the first detection), the "
-        "share of that time the pursuer stood (turning in place: scanning), and tracking "
+        "share of that time the pursuer stood (turning in place: scanning), the estimate's "
+        "mean error (m, the estimator's mean against the true evader) and the share of the "
+        "lost time the pursuer was within 0.5 m of the estimate, and tracking "
         "(share of ticks detected).",
         "",
         "| reading | v_p/v_e | tracked | v cmd / got (m/s) | v_max | at v_max | w cmd / got (rad/s) "
         "| at w_max | still | range (m) | gain | bearing | turning | blocked | occluded | missed "
-        "| far/near | s/loss | scanning |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| far/near | s/loss | scanning | estimate error (m) | at the estimate |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, preset in readings.items():
         for ratio in RATIOS:
@@ -148,7 +157,9 @@ def servo_table(readings: dict[str, str], env: str, seeds: int) -> list[str]:
                 f"| {per['turning']:.1f} | {per['blocked']:.1f} | {per['occluded']:.1f} "
                 f"| {per['missed']:.1f} | {per['far'] + per['near']:.1f} "
                 f"| {tot['lost'] / max(sum(losses.values()), 1):.1f} "
-                f"| {tot['scan'] / max(tot['lost'], 1e-9):.0%} |"
+                f"| {tot['scan'] / max(tot['lost'], 1e-9):.0%} "
+                f"| {tot['error'] / max(tot['estimated'], 1e-9):.2f} "
+                f"| {tot['there'] / max(tot['estimated'], 1e-9):.0%} |"
             )
             print(lines[-1], file=sys.stderr)
     return lines
