@@ -1,8 +1,10 @@
 """The games do not change: every built-in plugin on fixed seeds gives the stored measures.
 
 The measures in ``tests/data/reference_games.json`` were recorded by
-``python tests/reference_games.py`` before the redesign of the architecture; a change that
-alters any game fails here. Floats are compared exactly: the same seed and config give
+``python -m pegame.testing.reference_games`` before the redesign of the architecture (the
+3D games re-recorded when the pybullet evader became an articulated person and the camera
+took the paper's tilt and 320x240, 4c45a4e; the grid games never); a change that alters
+any game fails here. Floats are compared exactly: the same seed and config give
 the same game, bit for bit.
 """
 

@@ -149,9 +149,8 @@ class PybulletSimulator(Simulator):
 
     @dataclass
     class Config:
-        # px, rendered image size: half the TurtleBot camera's 640 x 480, for speed (README)
-        width: int = 320
-        height: int = 240
+        width: int = 320  # px, image width: half the TurtleBot camera's 640, for speed (README)
+        height: int = 240  # px, image height: half the TurtleBot camera's 480
         camera_hz: float = 10.0  # Hz; a frame is rendered when due, the last one reused otherwise
         camera_height: float = 0.4  # m, optical centre above the floor
         camera_tilt: float = PAPER_TILT  # rad, downward pitch (0: level)
