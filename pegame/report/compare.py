@@ -21,8 +21,6 @@ last_seen, true).
 
 from __future__ import annotations
 
-import csv
-import io
 from typing import Any
 
 from pegame.errors import PegameError
@@ -32,9 +30,9 @@ from pegame.report.paired import TEST_NAME, by_seed, difference_text, paired_tes
 from pegame.report.statistics import ALPHA, holm
 from pegame.report.tables import (
     CELL_COLUMNS,
-    CELL_CSV_COLUMNS,
+    blank,
     cell_texts,
-    cell_values,
+    cells_csv,
     markdown_rows,
 )
 
@@ -248,9 +246,6 @@ def render_compare_md(comparison: dict[str, Any]) -> str:
 def render_compare_csv(comparison: dict[str, Any]) -> str:
     """compare_<factor>.csv: the other factors, map, speed_ratio, pairing, then
     :data:`STATS`; rates as fractions, empty where not tested."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow([*comparison["others"], *CELL_CSV_COLUMNS, *STATS])
-    for row in comparison["rows"]:
-        writer.writerow([*cell_values(row), *("" if row[s] is None else row[s] for s in STATS)])
-    return buffer.getvalue()
+    return cells_csv(
+        comparison["others"], STATS, comparison["rows"], lambda row: [blank(row[s]) for s in STATS]
+    )

@@ -11,8 +11,6 @@ that measure's n.
 
 from __future__ import annotations
 
-import csv
-import io
 from typing import Any
 
 from pegame.report.cells import Cell
@@ -20,10 +18,10 @@ from pegame.report.measures import MEASURES, values
 from pegame.report.statistics import describe
 from pegame.report.tables import (
     CELL_COLUMNS,
-    CELL_CSV_COLUMNS,
+    blank,
     cell_text,
     cell_texts,
-    cell_values,
+    cells_csv,
     markdown_rows,
 )
 
@@ -86,15 +84,13 @@ def render_estimation_md(table: dict[str, Any]) -> str:
 def render_estimation_csv(table: dict[str, Any]) -> str:
     """estimation.csv: the other factors, map, speed_ratio, pairing, games, then per
     measure its n, mean, ci_low and ci_high (empty where no game defines it)."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
     columns = [f"{name}_{s}" for name in table["measures"] for s in STATS]
-    writer.writerow([*table["factors"], *CELL_CSV_COLUMNS, "games", *columns])
-    for row in table["rows"]:
-        stats = [
-            "" if row[name][s] is None else row[name][s]
-            for name in table["measures"]
-            for s in STATS
-        ]
-        writer.writerow([*cell_values(row), row["games"], *stats])
-    return buffer.getvalue()
+    return cells_csv(
+        table["factors"],
+        ["games", *columns],
+        table["rows"],
+        lambda row: [
+            row["games"],
+            *(blank(row[name][s]) for name in table["measures"] for s in STATS),
+        ],
+    )

@@ -20,8 +20,6 @@ cell with a segment per cause. Written whenever some game carries loss causes.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from typing import Any
 
@@ -32,9 +30,9 @@ from pegame.report.cells import Cell, value_text
 from pegame.report.figures import figure_bytes
 from pegame.report.tables import (
     CELL_COLUMNS,
-    CELL_CSV_COLUMNS,
+    blank,
     cell_texts,
-    cell_values,
+    cells_csv,
     markdown_rows,
 )
 
@@ -135,15 +133,17 @@ def render_losses_md(table: dict[str, Any]) -> str:
 def render_losses_csv(table: dict[str, Any]) -> str:
     """losses.csv: the other factors, map, speed_ratio, pairing, games, losses_per_game,
     then per cause its :data:`STATS` (empty where undefined)."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
     columns = [f"{cause}_{s}" for cause in table["causes"] for s in STATS]
-    writer.writerow([*table["factors"], *CELL_CSV_COLUMNS, "games", "losses_per_game", *columns])
-    for row in table["rows"]:
-        stats = ["" if row[c][s] is None else row[c][s] for c in table["causes"] for s in STATS]
-        total = "" if row["losses_per_game"] is None else row["losses_per_game"]
-        writer.writerow([*cell_values(row), row["games"], total, *stats])
-    return buffer.getvalue()
+    return cells_csv(
+        table["factors"],
+        ["games", "losses_per_game", *columns],
+        table["rows"],
+        lambda row: [
+            row["games"],
+            blank(row["losses_per_game"]),
+            *(blank(row[c][s]) for c in table["causes"] for s in STATS),
+        ],
+    )
 
 
 def _label(row: dict[str, Any]) -> str:

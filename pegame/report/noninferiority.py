@@ -27,8 +27,6 @@ It is always on the tracking rate (higher is better), whatever ``--metric`` is.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from typing import Any
 
@@ -42,9 +40,9 @@ from pegame.report.paired import BySeed, by_seed
 from pegame.report.statistics import ALPHA, holm
 from pegame.report.tables import (
     CELL_COLUMNS,
-    CELL_CSV_COLUMNS,
+    blank,
     cell_texts,
-    cell_values,
+    cells_csv,
     markdown_rows,
 )
 
@@ -224,9 +222,6 @@ def render_noninferior_md(result: dict[str, Any]) -> str:
 def render_noninferior_csv(result: dict[str, Any]) -> str:
     """noninferior_<factor>.csv: the other factors, map, speed_ratio, pairing, then
     :data:`STATS`; rates as fractions, empty where not tested."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow([*result["others"], *CELL_CSV_COLUMNS, *STATS])
-    for row in result["rows"]:
-        writer.writerow([*cell_values(row), *("" if row[s] is None else row[s] for s in STATS)])
-    return buffer.getvalue()
+    return cells_csv(
+        result["others"], STATS, result["rows"], lambda row: [blank(row[s]) for s in STATS]
+    )

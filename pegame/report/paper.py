@@ -23,10 +23,9 @@ from pegame.report.cells import Cell, facets
 from pegame.report.hypotheses import facet_text
 from pegame.report.tables import (
     CELL_COLUMNS,
-    CELL_CSV_COLUMNS,
     cell_text,
     cell_texts,
-    cell_values,
+    cells_csv,
     markdown_rows,
 )
 
@@ -140,9 +139,4 @@ def render_paper_md(versus: dict[str, Any]) -> str:
 def render_paper_csv(versus: dict[str, Any]) -> str:
     """vs_paper.csv: the other factors, map, speed_ratio, pairing, then :data:`STATS`
     (fractions)."""
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow([*versus["factors"], *CELL_CSV_COLUMNS, *STATS])
-    for row in versus["rows"]:
-        writer.writerow([*cell_values(row), *(row[s] for s in STATS)])
-    return buffer.getvalue()
+    return cells_csv(versus["factors"], STATS, versus["rows"], lambda row: [row[s] for s in STATS])

@@ -12,6 +12,7 @@ from __future__ import annotations
 import csv
 import io
 import re
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
 from pegame.bootstrap import BOOT_LEVEL, BOOT_RESAMPLES
@@ -130,6 +131,27 @@ def cell_values(row: dict[str, Any]) -> list[Any]:
     :data:`CELL_CSV_COLUMNS`."""
     factors = [csv_value(v) for v in row["factors"].values()]
     return [*factors, row["map"], row["speed_ratio"], row["pairing"]]
+
+
+def blank(value: Any) -> Any:
+    """A CSV cell: empty where there is no value."""
+    return "" if value is None else value
+
+
+def cells_csv(
+    factors: Sequence[str],
+    columns: Sequence[str],
+    rows: Iterable[dict[str, Any]],
+    values: Callable[[dict[str, Any]], list[Any]],
+) -> str:
+    """A per-cell table as CSV: the header ``factors``, :data:`CELL_CSV_COLUMNS`,
+    ``columns``; then each row's :func:`cell_values` and ``values(row)``."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow([*factors, *CELL_CSV_COLUMNS, *columns])
+    for row in rows:
+        writer.writerow([*cell_values(row), *values(row)])
+    return buffer.getvalue()
 
 
 def markdown_rows(header: list[str], rows: list[list[str]]) -> list[str]:
