@@ -28,7 +28,7 @@ import gymnasium
 import numpy as np
 
 import pegame.envs  # noqa: F401  (registers pegame/Pursuit-v0)
-from pegame.envs.observations import ObservationSettings
+from pegame.observe.observations import ObservationSettings
 from pegame.policies import LinearPolicy
 
 

@@ -24,7 +24,7 @@ import numpy as np
 from train_cem import options, train  # the options and the CEM loop, shared
 
 from pegame.envs import vector_env
-from pegame.envs.observations import ObservationSettings
+from pegame.observe.observations import ObservationSettings
 from pegame.policies import LinearPolicy
 
 

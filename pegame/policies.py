@@ -1,7 +1,7 @@
 """Learned policies as pegame strategies: loading them and playing them in a game.
 
-A policy maps an observation vector of :mod:`pegame.envs.observations` (float32, the
-env's layout) to an action of :mod:`pegame.envs.actions` (2 numbers (v, w) scaled to
+A policy maps an observation vector of :mod:`pegame.observe.observations` (float32, the
+env's layout) to an action of :mod:`pegame.observe.actions` (2 numbers (v, w) scaled to
 [-1, 1]). It is given as
 
 - ``"package.module:function"``: any callable ``f(obs) -> action`` (for example a
@@ -30,10 +30,10 @@ from typing import Any
 import numpy as np
 
 from pegame.api import Context, EvaderObservation, PursuerObservation, Strategy
-from pegame.envs.actions import to_velocity
-from pegame.envs.observations import EvaderFeatures, ObservationSettings, PursuerFeatures
-from pegame.envs.settings import EnvSettings
 from pegame.errors import ConfigError, require
+from pegame.observe.actions import to_velocity
+from pegame.observe.observations import EvaderFeatures, ObservationSettings, PursuerFeatures
+from pegame.observe.settings import EnvSettings
 from pegame.types import Body, Plan, Pose, Velocity
 
 #: version of the .npz layout written by save()

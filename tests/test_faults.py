@@ -17,8 +17,8 @@ import pytest
 
 from pegame import files, job
 from pegame.config import compose
-from pegame.envs.observations import ObservationSettings
 from pegame.errors import ConfigError
+from pegame.observe.observations import ObservationSettings
 from pegame.policies import LinearPolicy
 from pegame.recorders.files import recording_status
 from pegame.sweep import OWNER_FILE

@@ -11,10 +11,10 @@ import pytest
 
 from pegame import registry
 from pegame.config import compose
-from pegame.envs.observations import ObservationSettings
 from pegame.errors import ConfigError
 from pegame.evaders.policy import PolicyEvader
 from pegame.game import Game
+from pegame.observe.observations import ObservationSettings
 from pegame.policies import LinearPolicy, load_policy
 from pegame.pursuers.policy import PolicyPursuer
 from pegame.testing import chase, flee

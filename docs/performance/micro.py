@@ -22,11 +22,11 @@ import timeit
 import numpy as np
 
 from pegame.config import compose
-from pegame.envs.crop import LocalCrop, _crop
 from pegame.game import Game
 from pegame.grid.cells import cell_centres
 from pegame.navigation.planner import Planner
 from pegame.numerics import exps
+from pegame.observe.crop import LocalCrop, _crop
 from pegame.types import Pose
 
 

@@ -12,12 +12,14 @@
 
 Every env takes the app's config (``config=`` a composed DictConfig, or ``overrides=``
 the command-line overrides: any map, simulator, detector, estimator, opponent) and the
-options of :class:`pegame.envs.settings.EnvSettings`. Observations
-(:mod:`pegame.envs.observations`) are shared with the ``policy`` pursuer and evader,
-which play a trained policy in ordinary games.
+options of :class:`pegame.observe.settings.EnvSettings` (validated by
+:func:`pegame.observe.settings.env_settings`). Observations and actions live in
+:mod:`pegame.observe`, shared with the ``policy`` pursuer and evader, which play a
+trained policy in ordinary games without importing this package.
 
-The env classes need gymnasium and pettingzoo (``pip install pegame[rl]``); the
-observation code does not. The PettingZoo env is imported on first use.
+The env classes need gymnasium and pettingzoo (``pip install pegame[rl]``); importing
+this package registers the Gymnasium ids when gymnasium is installed. The PettingZoo env
+is imported on first use.
 """
 
 from __future__ import annotations

@@ -145,7 +145,7 @@ def bench_vector_env(
     spawns each game in Python: its cost per game is ``vector_reset_ms_per_game``).
     Figures are medians over the rounds; ``vector_speedup_per_core`` is the median of the
     rounds' ratios to the single env.
-    ``settings``: env options (:class:`pegame.envs.settings.EnvSettings`) for both.
+    ``settings``: env options (:class:`pegame.observe.settings.EnvSettings`) for both.
     Memory per game: the resident memory the batched env added (its kernels already
     loaded), divided by the games; and the bytes of its arrays per game (state, opponent
     table, one observation).

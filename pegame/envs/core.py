@@ -27,12 +27,12 @@ from typing import TYPE_CHECKING, overload
 import numpy as np
 from omegaconf import DictConfig
 
-from pegame.envs.actions import to_velocity
-from pegame.envs.observations import EvaderFeatures, PursuerFeatures
-from pegame.envs.settings import EnvSettings
 from pegame.errors import ConfigError
 from pegame.game import Scenario
 from pegame.loop import TickLoop, nearest
+from pegame.observe.actions import to_velocity
+from pegame.observe.observations import EvaderFeatures, PursuerFeatures
+from pegame.observe.settings import EnvSettings
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from pegame.render import FrameRenderer

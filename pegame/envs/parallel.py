@@ -5,8 +5,8 @@ team game (``team.pursuers=N``, ``team.evaders=M`` in the overrides or config) t
 are ``pursuer_0`` .. ``pursuer_{N-1}`` and ``evader_0`` .. ``evader_{M-1}``, every pursuer
 with the team's reward and every evader with its own (:mod:`pegame.envs.core`).
 Spaces, per agent: ``Box(-1, 1, (2,), float32)`` actions (v, w) scaled to the agent's
-limits (:mod:`pegame.envs.actions`) and a flat float32 ``Box`` observation
-(:mod:`pegame.envs.observations`; ``env.layouts[agent]`` names its parts). Rewards,
+limits (:mod:`pegame.observe.actions`) and a flat float32 ``Box`` observation
+(:mod:`pegame.observe.observations`; ``env.layouts[agent]`` names its parts). Rewards,
 infos and episode length: :mod:`pegame.envs.core`. Both agents are truncated together
 when the game's ``t_max`` is reached.
 """
@@ -21,8 +21,8 @@ from gymnasium import spaces
 from omegaconf import DictConfig
 from pettingzoo import ParallelEnv
 
+from pegame.observe.settings import env_config, env_settings
 from pegame.envs.core import RENDER_MODES, EnvGame, check_render_mode, check_seed, game_seed
-from pegame.envs.settings import env_config, env_settings
 from pegame.loop import ROLES
 
 
@@ -33,7 +33,7 @@ class PursuitEvasionParallelEnv(ParallelEnv):
     compose one from ``overrides`` (the app's command-line overrides, e.g.
     ``["env=hall", "game.t_max=30"]``). The ``pursuer`` and ``evader`` nodes give the
     bodies only; the config's ``game.seed`` is not used: seed with ``reset(seed=...)``.
-    settings: :class:`pegame.envs.settings.EnvSettings` fields (decision_period,
+    settings: :class:`pegame.observe.settings.EnvSettings` fields (decision_period,
     crop_cells, crop_resolution, belief, clip_actions). render_mode: None or
     ``"rgb_array"`` (``render()`` draws the game from above, :meth:`EnvGame.frame`).
     """

@@ -2,8 +2,8 @@
 ``pegame/Evasion-v0`` (the learner evades) against a pegame strategy.
 
 Spaces: ``Box(-1, 1, (2,), float32)`` actions (v, w) scaled to the learner's limits
-(:mod:`pegame.envs.actions`) and a flat float32 ``Box`` observation
-(:mod:`pegame.envs.observations`; ``env.unwrapped.layout`` names its parts). Rewards,
+(:mod:`pegame.observe.actions`) and a flat float32 ``Box`` observation
+(:mod:`pegame.observe.observations`; ``env.unwrapped.layout`` names its parts). Rewards,
 infos and episode length: :mod:`pegame.envs.core`; the end of the game is a truncation.
 """
 
@@ -17,8 +17,8 @@ import numpy as np
 from gymnasium import spaces
 from omegaconf import DictConfig
 
+from pegame.observe.settings import env_config, env_settings
 from pegame.envs.core import RENDER_MODES, EnvGame, check_render_mode, check_seed, game_seed
-from pegame.envs.settings import env_config, env_settings
 from pegame.errors import ConfigError
 
 PURSUIT_ID = "pegame/Pursuit-v0"

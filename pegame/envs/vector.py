@@ -38,8 +38,8 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import ArrayLike
 from omegaconf import DictConfig
 
+from pegame.observe.settings import env_config, env_settings
 from pegame.envs.core import check_seed
-from pegame.envs.settings import env_config, env_settings
 from pegame.errors import ConfigError
 from pegame.loop import ROLES
 from pegame.vector import BatchedGame

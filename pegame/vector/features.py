@@ -1,6 +1,6 @@
-"""The observations of a batched game, per game: :class:`pegame.envs.observations.
+"""The observations of a batched game, per game: :class:`pegame.observe.observations.
 PursuerFeatures` and ``EvaderFeatures`` (no belief part), with the crop of
-:func:`pegame.envs.crop._crop` (:func:`crop_into`), the same float operations
+:func:`pegame.observe.crop._crop` (:func:`crop_into`), the same float operations
 (``tests/test_vector_kernels.py`` compares the crop, ``tests/test_vector_env.py`` the
 observations). Parallel over games from PARALLEL_GAMES games on.
 """
@@ -12,10 +12,10 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from pegame.envs.crop import CropLattice, CropScratch, lattice_crop
-from pegame.envs.observations import AGE_SCALE
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.numerics import cell_by_division, hypot, wrap_angle
+from pegame.observe.crop import CropLattice, CropScratch, lattice_crop
+from pegame.observe.observations import AGE_SCALE
 from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER, BatchState, Rules, World
 
 
@@ -42,7 +42,7 @@ def _pose_features(
 def _divided_crop(
     world: World, x: float, y: float, c: float, s: float, out: np.ndarray, at: int
 ) -> None:
-    """The crop's cells by the reference's own operations (:func:`pegame.envs.crop._crop`,
+    """The crop's cells by the reference's own operations (:func:`pegame.observe.crop._crop`,
     ``world_to_cell``'s division), into out[at:]."""
     table, off_x, off_y, frame = world.crop_table, world.crop_x, world.crop_y, world.crop_frame
     height, width = world.pooled.shape
@@ -65,9 +65,9 @@ def _divided_crop(
 def crop_into(
     world: World, x: float, y: float, theta: float, out: np.ndarray, at: int, cells: np.ndarray
 ) -> bool:
-    """The crop of :class:`pegame.envs.crop.LocalCrop` around the pose (x m, y m, theta
-    rad) into out[at:], the cells of :func:`pegame.envs.crop._crop` (``cells``: int32
-    scratch of the crop's size): from the crop's lattice (:func:`pegame.envs.crop.lattice_crop`), or by
+    """The crop of :class:`pegame.observe.crop.LocalCrop` around the pose (x m, y m, theta
+    rad) into out[at:], the cells of :func:`pegame.observe.crop._crop` (``cells``: int32
+    scratch of the crop's size): from the crop's lattice (:func:`pegame.observe.crop.lattice_crop`), or by
     the division when the lattice does not decide every cell (a pose on cell edges), as
     the features' loop finds them. Returns whether the division was needed.
     ``tests/test_vector_kernels.py`` compares the crop with the reference on random poses

@@ -67,13 +67,13 @@ from pegame.detectors.perception import (
     reset_pipeline,
     runs_pipeline,
 )
-from pegame.envs.crop import LocalCrop
-from pegame.envs.observations import EvaderFeatures, PursuerFeatures
-from pegame.envs.settings import EnvSettings
 from pegame.errors import ConfigError
 from pegame.game import STREAMS, Scenario, spawn
 from pegame.grid import OccupancyGrid
 from pegame.navigation import shared_inflation
+from pegame.observe.crop import LocalCrop
+from pegame.observe.observations import EvaderFeatures, PursuerFeatures
+from pegame.observe.settings import EnvSettings
 from pegame.sims.grid import GridSimulator, body_rows
 from pegame.vector import kernels
 from pegame.vector.features import features

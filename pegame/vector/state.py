@@ -68,7 +68,7 @@ class World(NamedTuple):
     tuple of mixed types cannot enter numba's parallel loops); masks: (2, H, W) the
     grid inflated by the pursuer's and the evader's radius (the simulator's collision
     masks); pooled, crop_x, crop_y, crop_frame: the crop's pooled map, robot-frame cell
-    offsets (m) and its map-to-cell numbers (:class:`pegame.envs.crop.LocalCrop`, float64);
+    offsets (m) and its map-to-cell numbers (:class:`pegame.observe.crop.LocalCrop`, float64);
     crop_table: uint8 (H + 2 pad, W + 2 pad): the pooled map (1 blocked, 0 free)
     in a border of ``pad`` blocked cells wider than the crop's reach, the crop's look-up
     table; crop_centres: float64 (crop_cells,): the crop's cell centres along one axis

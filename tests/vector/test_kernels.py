@@ -9,9 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from pegame.envs.crop import local_crop_reference
 from pegame.envs.vector import vector_env
 from pegame.grid import OccupancyGrid
+from pegame.observe.crop import local_crop_reference
 from pegame.types import Pose
 from pegame.vector import camera as batched_camera
 from pegame.vector.features import crop_into

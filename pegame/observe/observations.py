@@ -22,7 +22,7 @@ Pursuer (:class:`PursuerFeatures`):
 - ``belief`` (4, only with ``belief=True``): has an estimate (0/1); the estimate's
   position in the robot frame / D (x, y); sqrt(trace(covariance)) / D capped at 1 (0
   without a covariance). All 0 without an estimate;
-- ``crop`` (cells^2): the egocentric occupancy crop (:mod:`pegame.envs.crop`).
+- ``crop`` (cells^2): the egocentric occupancy crop (:mod:`pegame.observe.crop`).
 
 Evader (:class:`EvaderFeatures`), which is told the pursuer's pose as in the paper:
 
@@ -42,8 +42,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pegame.api import Context, EvaderObservation, PursuerObservation
-from pegame.envs.crop import LocalCrop
 from pegame.errors import require
+from pegame.observe.crop import LocalCrop
 from pegame.types import Belief, Detection, Pose, wrap_angle
 
 #: s; detection ages are divided by this and capped at 1

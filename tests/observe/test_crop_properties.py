@@ -1,4 +1,4 @@
-"""Property-based tests of the egocentric crop (pegame.envs.crop): the crop's kernels, the
+"""Property-based tests of the egocentric crop (pegame.observe.crop): the crop's kernels, the
 lattice route and the division, against :func:`local_crop_reference` on generated grids,
 crop sizes and resolutions, and poses anywhere on or off the map, on cell corners and
 edges and along the grid's axes; and more obstacles never free a crop cell. Units:
@@ -13,8 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from pegame.envs.crop import LocalCrop, _crop, lattice_crop, local_crop_reference
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from pegame.observe.crop import LocalCrop, _crop, lattice_crop, local_crop_reference
 
 
 @st.composite

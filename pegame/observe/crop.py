@@ -163,7 +163,7 @@ def lattice_crop(lattice: tuple, pose: Heading, out: np.ndarray, at: int, scratc
     + 4 max|o|) / res, a bound (cells) on every quantity either route forms. A rounding
     errs by at most u times its quantity, and reaches a final coordinate through sums,
     products by cos/sin (at most 1) and the scaling to cells, so it moves the coordinate
-    by at most u L (1 + u)^k. Per coordinate the reference (:func:`pegame.envs.crop._crop`)
+    by at most u L (1 + u)^k. Per coordinate the reference (:func:`pegame.observe.crop._crop`)
     rounds 14 times (5 for each of dx and dy, the grid rotation's 3, the division) and
     this route 18 times (fl(1 / res) in the three scaled terms, the axes' 3 + 3, the
     position's 2 + 3, the lattice's two products and two sums), so the two are within

@@ -12,8 +12,8 @@ from typing import Any
 from omegaconf import DictConfig, OmegaConf
 
 from pegame.config import compose, plain
-from pegame.envs.observations import ObservationSettings
 from pegame.errors import ConfigError, require
+from pegame.observe.observations import ObservationSettings
 
 
 @dataclass(frozen=True)
