@@ -13,7 +13,7 @@
 Every env takes the app's config (``config=`` a composed DictConfig, or ``overrides=``
 the command-line overrides: any map, simulator, detector, estimator, opponent) and the
 options of :class:`pegame.observe.settings.EnvSettings` (validated by
-:func:`pegame.observe.settings.env_settings`). Observations and actions live in
+:func:`pegame.envs.config.env_settings`). Observations and actions live in
 :mod:`pegame.observe`, shared with the ``policy`` pursuer and evader, which play a
 trained policy in ordinary games without importing this package.
 

@@ -17,7 +17,7 @@ import numpy as np
 from gymnasium import spaces
 from omegaconf import DictConfig
 
-from pegame.observe.settings import env_config, env_settings
+from pegame.envs.config import env_config, env_settings
 from pegame.envs.core import RENDER_MODES, EnvGame, check_render_mode, check_seed, game_seed
 from pegame.errors import ConfigError
 

@@ -38,7 +38,7 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import ArrayLike
 from omegaconf import DictConfig
 
-from pegame.observe.settings import env_config, env_settings
+from pegame.envs.config import env_config, env_settings
 from pegame.envs.core import check_seed
 from pegame.errors import ConfigError
 from pegame.loop import ROLES
