@@ -150,7 +150,7 @@ def run_job(
     PegameError before the first game for a config that cannot be played at all, or a
     directory that belongs to another job; nothing is written to the directory then."""
     out_dir = Path(out_dir)
-    with JobLock(out_dir):
+    with sweep.watched_job(), JobLock(out_dir):
         return _run_locked(cfg, out_dir, base_dir, list(overrides), adopt, cell)
 
 

@@ -18,7 +18,9 @@ touching a file: while the first runs, and after it ended unless it is a resume
 Orphaned workers: a worker process whose parent (the sweep's process) was killed
 (``kill -9``) is re-parented and would go on appending games, racing a later resume.
 :func:`sweep_parent` tells a job that it runs in such a worker; the job checks
-:func:`orphaned` between games and stops.
+:func:`orphaned` between games and stops. A worker whose job already ended waits for the
+next job in its launcher (loky keeps an idle worker 300 s); :func:`watched_job` starts a
+thread that ends such a worker as soon as the sweep's process is gone.
 """
 
 from __future__ import annotations
@@ -30,8 +32,11 @@ import shlex
 import shutil
 import sys
 import tempfile
+import threading
 import time
 import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from pegame.errors import JobDirectoryError
@@ -46,8 +51,13 @@ SWEEP_PID_ENV = "PEGAME_SWEEP_PID"
 #: the file of a sweep directory that names its owner and carries its flock
 OWNER_FILE = ".pegame-sweep"
 
+#: s between two looks of an idle worker's watchdog at its parent
+WATCH_PERIOD = 0.5
+
 _worst = OK
 _owner_fd: int | None = None
+_jobs_running = 0
+_watched_parent: int | None = None
 
 
 class SweepOwnedError(JobDirectoryError):
@@ -187,3 +197,30 @@ def orphaned(parent: int | None) -> bool:
     """Whether the sweep process ``parent`` (from :func:`sweep_parent`) has died: the
     worker was re-parented, so its parent PID changed."""
     return parent is not None and os.getppid() != parent
+
+
+@contextmanager
+def watched_job() -> Iterator[None]:
+    """Run a job in this process; when it is a sweep's worker (:func:`sweep_parent`), a
+    daemon thread, started with its first job, exits the process within
+    :data:`WATCH_PERIOD` s of the sweep's process dying while no job runs here (a running
+    job stops itself between games, after a complete line). Without it an idle worker of
+    a killed sweep would linger until its launcher's idle timeout."""
+    global _jobs_running, _watched_parent
+    parent = sweep_parent()
+    if parent is not None and _watched_parent is None:
+        _watched_parent = parent
+        threading.Thread(
+            target=_watch, args=(parent,), name="pegame-orphan-watch", daemon=True
+        ).start()
+    _jobs_running += 1
+    try:
+        yield
+    finally:
+        _jobs_running -= 1
+
+
+def _watch(parent: int) -> None:
+    while not (orphaned(parent) and _jobs_running == 0):
+        time.sleep(WATCH_PERIOD)
+    os._exit(GAMES_FAILED)

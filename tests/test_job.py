@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -204,18 +205,22 @@ def test_multirun_through_submitit_local(tmp_path):
 TRIALS = 50  # enough games that the sweep is still running when it is interrupted
 SWEEP = [
     *SHORT,
-    f"game.trials={TRIALS}",
     "pursuer=random",
-    "evader=random,smart",
     "hydra/launcher=joblib",
     "hydra.launcher.n_jobs=2",
 ]
 
 
-def start_sweep(tmp_path: Path, *extra: str, sigint_ignored: bool = False) -> subprocess.Popen:
-    """The interrupt tests' sweep, its stdout (one summary line per game, unbuffered in
-    every process) and stderr piped; ``sigint_ignored``: start it with SIGINT ignored, as
-    a background job or a test runner's worker would."""
+def start_sweep(
+    tmp_path: Path,
+    *extra: str,
+    sigint_ignored: bool = False,
+    cells: tuple[str, ...] = (f"game.trials={TRIALS}", "evader=random,smart"),
+) -> subprocess.Popen:
+    """The interrupt tests' sweep of two jobs (``cells``: the overrides that make them),
+    its stdout (one summary line per game, unbuffered in every process) and stderr piped;
+    ``sigint_ignored``: start it with SIGINT ignored, as a background job or a test
+    runner's worker would."""
     env = {k: v for k, v in os.environ.items() if k != "HYDRA_FULL_ERROR"}
     env["PYTHONUNBUFFERED"] = "1"
     ignore = (lambda: signal.signal(signal.SIGINT, signal.SIG_IGN)) if sigint_ignored else None
@@ -226,6 +231,7 @@ def start_sweep(tmp_path: Path, *extra: str, sigint_ignored: bool = False) -> su
             "pegame",
             "-m",
             *SWEEP,
+            *cells,
             f"hydra.sweep.dir={tmp_path / 'sweep'}",
             *extra,
         ],
@@ -302,6 +308,25 @@ def test_kill_9_of_the_sweep_parent_stops_its_workers_and_resume_completes(tmp_p
     for path in sorted((tmp_path / "sweep").glob("*/results.jsonl")):
         seeds = [e["seed"] for e in job.read_lines(path) if e.get("kind") == "game"]
         assert sorted(seeds) == list(range(TRIALS)), path  # every game once: no race, none lost
+
+
+@pytest.mark.slow
+def test_kill_9_of_the_sweep_parent_ends_a_worker_whose_job_had_ended(tmp_path):
+    # a worker whose job had ended waited in loky for the next one, 300 s after the kill
+    proc = start_sweep(tmp_path, cells=("game.trials=2,400", "evader=random"))
+    threading.Thread(target=proc.stdout.read, daemon=True).start()
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline:
+        stored = games_stored(tmp_path)
+        if len(stored) == 2 and min(stored) >= 2:
+            break
+        time.sleep(0.1)
+    workers = loky_workers(proc.pid)
+    assert len(workers) == 2
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=60)
+    assert all(wait_exit(pid, timeout=30) for pid in workers), "a worker outlived the sweep"
+    assert sum(games_stored(tmp_path)) < 402
 
 
 @pytest.mark.slow
