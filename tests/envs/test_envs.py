@@ -281,3 +281,15 @@ def test_a_misspelt_opponent_gets_did_you_mean():
 
     with pytest.raises(PluginChoiceError, match="Unknown evader 'smrt'. Did you mean 'smart'?"):
         gymnasium.make(IDS[0], overrides=SHORT, opponent="smrt")
+
+
+def test_the_old_observations_path_is_a_deprecated_re_export(monkeypatch):
+    import importlib
+    import sys
+
+    import pegame.observe.observations as observations
+
+    monkeypatch.delitem(sys.modules, "pegame.envs.observations", raising=False)
+    with pytest.deprecated_call(match="pegame.observe.observations"):
+        old = importlib.import_module("pegame.envs.observations")
+    assert old.ObservationSettings is observations.ObservationSettings
