@@ -17,7 +17,12 @@ growing with range and with the hidden fraction of the evader's silhouette, dept
 growing with range (Khoshelham & Elberink 2012) and bearing noise, both entering before
 the box is drawn, and false positives. The independent miss and the depth noise draw from
 the detector's own generator, two numbers for every evader in view, as they always have;
-the other parts from their own generators, only when they are on.
+the other parts from their own generators, only when they are on. With a profile
+(``detector.profile``, :mod:`pegame.detectors.profile`) an evader in view and in range is
+detected with the profile's chance for its range, bearing, visible fraction and lateral
+speed relative to the camera (from the previous call's poses), and its position carries
+the profile's error: one uniform and two normal draws from the profile's generator per
+such frame.
 """
 
 from __future__ import annotations
@@ -30,7 +35,7 @@ import numpy as np
 from pegame.api import Context, Detector
 from pegame.detectors.perception import Perception, PerceptionConfig, hidden_fraction, pinhole_box
 from pegame.errors import require
-from pegame.types import Detection, SensorFrame, wrap_angle
+from pegame.types import Detection, Pose, SensorFrame, wrap_angle
 from pegame.visibility import in_view
 
 
@@ -60,14 +65,37 @@ class OracleDetector(Detector):
         self.perception = Perception(
             config, context, rng, config.evader_height, config.camera_height
         )
+        self.reset()
 
     def reset(self) -> None:
         self.perception.reset()
+        self._lateral = math.nan  # m/s, see _lateral_speed
+        self._last: tuple[float, Pose, Pose] | None = None
 
     def detect(self, frame: SensorFrame) -> Detection | None:
+        if self.perception.profile is not None:
+            self._lateral_speed(frame)
         if self.perception.passthrough:  # each frame's own capture (no closure to build)
             return self._capture(frame)
         return self.perception.deliver(frame.time, frame.camera_pose, lambda: self._capture(frame))
+
+    def _lateral_speed(self, frame: SensorFrame) -> None:
+        """The evader's speed (m/s) across the line of sight relative to the camera, from
+        this frame's and the previous call's poses, as the profile measures it (NaN when
+        unknown)."""
+        cam, evader = frame.camera_pose, frame.evader_truth
+        self._lateral = math.nan
+        if evader is None:
+            self._last = None
+            return
+        dx, dy = evader.x - cam.x, evader.y - cam.y
+        distance = math.hypot(dx, dy)
+        if self._last is not None and distance > 1e-9 and frame.time > self._last[0]:
+            before, was_cam, was = self._last
+            rvx = (dx - (was.x - was_cam.x)) / (frame.time - before)
+            rvy = (dy - (was.y - was_cam.y)) / (frame.time - before)
+            self._lateral = abs(rvx * dy - rvy * dx) / distance
+        self._last = (frame.time, cam, evader)
 
     def _capture(self, frame: SensorFrame) -> Detection | None:
         """The detection of this frame, before the pipeline (rate, latency, bursts, false
@@ -83,6 +111,14 @@ class OracleDetector(Detector):
         miss, noise = self.rng.random(), self.rng.normal(0.0, 1.0)
         if miss < cfg.miss_probability:
             return None
+        profile = perception.profile
+        if profile is not None:
+            grid, radius = self.context.grid, self.context.evader.radius
+            visible = 1.0 - hidden_fraction(grid, camera, cam, (evader.x, evader.y), radius)
+            bearing = abs(wrap_angle(math.atan2(evader.y - cam.y, evader.x - cam.x) - cam.theta))
+            chance = profile.probability(distance, bearing, visible, self._lateral)
+            if perception.profile_rng.random() >= chance:
+                return None
         if perception.misses_by_range_or_occlusion:
             hidden = 0.0
             if cfg.occlusion_miss > 0:
@@ -105,4 +141,9 @@ class OracleDetector(Detector):
         seen_range = depth / math.cos(seen_bearing)
         heading = cam.theta + seen_bearing
         position = (cam.x + seen_range * math.cos(heading), cam.y + seen_range * math.sin(heading))
+        if profile is not None:  # the profile's error in the line of sight's frame
+            along, across = profile.position_error(perception.profile_rng)
+            sight = math.atan2(evader.y - cam.y, evader.x - cam.x)
+            c, s = math.cos(sight), math.sin(sight)
+            position = (position[0] + along * c - across * s, position[1] + along * s + across * c)
         return Detection(box=box, depth=depth, position=position)

@@ -39,6 +39,11 @@ another's draws.
   detected reports the evader (a single-target detector reports its best candidate).
 - Detection range: nothing beyond ``detection_range`` m (null: the camera's ``far``) is
   detected.
+- Identified profile: ``profile`` names a detection profile measured on the 3D pipeline
+  (:mod:`pegame.detectors.profile`): a seen evader is detected with the chance the profile
+  gives its range, bearing, visible fraction and lateral speed (naive Bayes over the
+  profile's marginal tables), and its position carries the profile's error; drawn from a
+  generator spawned after the parts', only when a profile is on.
 
 Only the detector knows what its raw detection is; it calls :meth:`Perception.deliver`
 with a function that captures one (applying the per-detection parts: range, misses,
@@ -63,6 +68,7 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 from numba import njit
 
+from pegame.detectors.profile import DetectionProfile, resolve
 from pegame.errors import ConfigError, require
 from pegame.types import XY, BoundingBox, Camera, Detection, Pose, wrap_angle
 from pegame.visibility import SILHOUETTE, in_view
@@ -106,8 +112,11 @@ class PerceptionConfig:
     range_noise_growth: float = 0.0  # 1/m, depth noise std growth (b in a + b * range^2)
     bearing_noise: float = 0.0  # rad, std of the bearing noise
     false_positive_rate: float = 0.0  # 1/s, false detections per second (Poisson)
+    profile: str | None = None  # a detection profile's name or CSV path (null: off)
 
     def __post_init__(self) -> None:
+        if self.profile is not None:
+            resolve(self.profile)  # a ConfigError naming the profiles
         if self.rate is not None:
             ok = math.isfinite(self.rate) and self.rate > 0
             require(ok, "rate", "a rate > 0 Hz, or null for every control tick", self.rate)
@@ -158,6 +167,17 @@ class PerceptionConfig:
                 f"Invalid value for 'detector.burst_length': {length!r}. Allowed: bursts and "
                 f"the runs between them (burst_length * (1 - f) / f with f = "
                 f"detector.burst_miss_fraction = {f}) of at least one frame, {step:g} s."
+            )
+        if self.profile is not None and (not self.occlusion or self.occlusion_miss > 0):
+            allowed = (
+                "null for this detector, which measures its own detections (a profile is the "
+                "oracle's, detector=oracle)"
+                if not self.occlusion
+                else "null, or a profile with detector.occlusion_miss=0 (the profile's "
+                "visible-fraction factor is its occlusion miss)"
+            )
+            raise ConfigError(
+                f"Invalid value for 'detector.profile': {self.profile!r}. Allowed: {allowed}."
             )
         if not self.occlusion and self.occlusion_miss > 0:
             raise ConfigError(
@@ -365,6 +385,10 @@ class Perception:
         self.miss_start = math.nan if config.miss_range_start is None else config.miss_range_start
         self.pipeline = new_pipeline(1, pipeline_slots(config.latency, self.period))
         self.misses_by_range_or_occlusion = misses_by_range_or_occlusion(config)
+        self.profile: DetectionProfile | None = None
+        if config.profile is not None:
+            self.profile = DetectionProfile.read(resolve(config.profile))
+            self.profile_rng = rng.spawn(1)[0]
         # Every pipeline part off: each tick delivers its own capture, nothing to hold.
         self.passthrough = not runs_pipeline(config)
         self.reset()

@@ -42,7 +42,7 @@ simulator; the oracle detector with the perception model's rate, latency, detect
 range and range and occlusion misses (every setting of ``+experiment=paper_conditions``
 but its turn order; the pipeline and the miss chance are the scalar detector's own
 kernels, :mod:`pegame.detectors.perception`), not its independent or bursty misses,
-noise or false positives; ``game.turn_order=simultaneous``; no belief in the
+noise, false positives or detection profile; ``game.turn_order=simultaneous``; no belief in the
 observation. A pursuer strategy as the opponent adds the loop's estimation per game
 in Python (:class:`pegame.vector.opponents.PursuerStrategyOpponent`).
 """
@@ -98,6 +98,7 @@ PERCEPTION_OFF = {
     "range_noise_growth": 0.0,
     "bearing_noise": 0.0,
     "false_positive_rate": 0.0,
+    "profile": None,
 }
 
 

@@ -1,7 +1,7 @@
 """The detection profile of a 3D detector, measured on played games (system identification).
 
 ``python -m pegame_vision.profile [--detector person] [--envs enclosed hall brick]
-[--seeds 2] [--t-max 60] [--out DIR] [overrides]`` plays S-S games in PyBullet driven by
+[--seeds 2] [--first-seed 0] [--t-max 60] [--out DIR] [overrides]`` plays S-S games in PyBullet driven by
 ``detector=segmentation`` with the detector under test judged beside it
 (:func:`pegame_vision.evaluate.judged_game`), and measures on every frame on which the
 reference sees the evader how often the detector finds it (box IoU >= 0.5 with the
@@ -16,11 +16,16 @@ reference's), as a function of
 
 each on its own (marginal tables), with the number of frames per bin; and, on frames on
 which the reference sees nothing, how often the detector reports something (false
-detections per frame), its median position error (m) and its CPU time per frame (ms).
-Every number comes from the 3D games alone. Writes ``<detector>.csv`` (columns
-``variable,low,high,frames,p_detect``; the false detection rate, the position error and the
-CPU time as rows of variable ``false_detection``, ``position_error_m`` and ``cpu_ms``) and
-``<detector>.md`` (the tables and the command and commit that made them) into ``--out``.
+detections per frame), its median position error (m), that error split along the line of
+sight (mean, signed: positive beyond the evader's centre, and std; m) and across it (std,
+m), and its CPU time per frame (ms). Every number comes from the 3D games alone. Writes
+``<detector>.csv`` (columns ``variable,low,high,frames,p_detect``; the false detection
+rate, the position error and the CPU time as rows of variable ``false_detection``,
+``position_error_m``, ``error_along_mean_m``, ``error_along_std_m``, ``error_across_std_m``
+and ``cpu_ms``), ``<detector>.md`` (the tables and the command and commit that made them)
+and ``<detector>_frames.csv`` (one row per frame: env, seed, the four variables, seen,
+found; what :mod:`pegame.detectors.profile` is checked against on held-out seeds,
+``--first-seed``) into ``--out``.
 """
 
 from __future__ import annotations
@@ -83,9 +88,13 @@ def frames(
                     lateral = abs(rvx * dy - rvy * dx) / distance
                 bearing = abs(math.remainder(math.atan2(dy, dx) - camera.theta, math.tau))
                 found = seen is not None and truth is not None and iou(truth.box, seen.box) >= IOU
-                error = None
+                error = along = across = None
                 if found and seen is not None:
-                    error = math.hypot(seen.position[0] - evader.x, seen.position[1] - evader.y)
+                    ex, ey = seen.position[0] - evader.x, seen.position[1] - evader.y
+                    error = math.hypot(ex, ey)
+                    if distance > 1e-9:  # the error in the line of sight's frame
+                        along = (ex * dx + ey * dy) / distance
+                        across = (ey * dx - ex * dy) / distance
                 records.append(
                     {
                         "env": env,
@@ -98,6 +107,8 @@ def frames(
                         "found": found,
                         "reported": seen is not None,
                         "error": error,
+                        "along": along,
+                        "across": across,
                     }
                 )
                 last = (time, camera, evader)
@@ -107,7 +118,8 @@ def frames(
 def profile_rows(records: list[dict[str, Any]], cpu: list[float]) -> list[tuple[Any, ...]]:
     """(variable, low, high, frames, value) rows: per variable and bin, the frames on which
     the reference saw the evader and the fraction the detector found; then the false
-    detections per frame the reference saw nothing on, the median position error (m) and
+    detections per frame the reference saw nothing on, the median position error (m), the
+    mean and std of its component along the line of sight and the std across it (m), and
     the median CPU time per frame (ms), each over all frames (low and high empty)."""
     rows: list[tuple[Any, ...]] = []
     seen = [r for r in records if r["seen"]]
@@ -125,6 +137,14 @@ def profile_rows(records: list[dict[str, Any]], cpu: list[float]) -> list[tuple[
     rows.append(
         ("position_error_m", "", "", len(errors), float(np.median(errors)) if errors else None)
     )
+    along = [r["along"] for r in seen if r["along"] is not None]
+    across = [r["across"] for r in seen if r["across"] is not None]
+    for name, values, statistic in (
+        ("error_along_mean_m", along, np.mean),
+        ("error_along_std_m", along, np.std),
+        ("error_across_std_m", across, np.std),
+    ):
+        rows.append((name, "", "", len(values), float(statistic(values)) if values else None))
     rows.append(("cpu_ms", "", "", len(cpu), 1e3 * float(np.median(cpu)) if cpu else None))
     return rows
 
@@ -145,7 +165,8 @@ def main(argv: list[str] | None = None) -> Path:
         "--detector", default="person", help="the detector under test (person, vision)"
     )
     parser.add_argument("--envs", nargs="+", default=["enclosed", "hall", "brick"])
-    parser.add_argument("--seeds", type=int, default=2, help="games per map, seeds 0..N-1")
+    parser.add_argument("--seeds", type=int, default=2, help="games per map")
+    parser.add_argument("--first-seed", type=int, default=0, help="seeds first..first+N-1")
     parser.add_argument("--t-max", type=float, default=60.0, help="s per game")
     parser.add_argument("--out", type=Path, default=Path("."), help="directory of the profile")
     parser.add_argument(
@@ -159,7 +180,8 @@ def main(argv: list[str] | None = None) -> Path:
     except (OSError, subprocess.CalledProcessError):
         commit = "unknown"
     cpu: list[float] = []
-    records = frames(args.detector, args.envs, range(args.seeds), args.t_max, args.overrides, cpu)
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    records = frames(args.detector, args.envs, seeds, args.t_max, args.overrides, cpu)
     rows = profile_rows(records, cpu)
     csv = "variable,low,high,frames,p_detect\n" + "".join(
         ",".join(_cell(v) for v in row) + "\n" for row in rows
@@ -174,13 +196,20 @@ def main(argv: list[str] | None = None) -> Path:
     text = (
         f"# Detection profile of detector={args.detector}\n\n"
         f"Made by `{command}` at commit {commit}: {len(records)} frames of S-S games on "
-        f"{', '.join(args.envs)}, seeds 0-{args.seeds - 1}, {args.t_max:g} s each, overrides "
+        f"{', '.join(args.envs)}, seeds {seeds[0]}-{seeds[-1]}, {args.t_max:g} s each, overrides "
         f"{args.overrides or 'none'}; from the 3D games alone (`pegame_vision.profile`'s "
         "docstring says how each number is measured).\n\n" + table + "\n"
     )
     args.out.mkdir(parents=True, exist_ok=True)
     write_atomic(args.out / f"{args.detector}.csv", csv)
     write_atomic(args.out / f"{args.detector}.md", text)
+    columns = ("env", "seed", *EDGES, "seen", "found")
+    write_atomic(
+        args.out / f"{args.detector}_frames.csv",
+        ",".join(columns)
+        + "\n"
+        + "".join(",".join(_cell(r[c]) for c in columns) + "\n" for r in records),
+    )
     return args.out
 
 
