@@ -242,7 +242,7 @@ class PolicyStrategy(Strategy[PursuerObservation | EvaderObservation]):
     commands velocities directly and makes no plan."""
 
     description = (
-        "A learned policy (linear .npz or module:function) on the pegame.envs observation."
+        "A learned policy (linear .npz or module:function) on the pegame.observe observation."
     )
     #: 'pursuer' or 'evader', set by :func:`pegame.roles.for_role`
     role: str
