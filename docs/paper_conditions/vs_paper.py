@@ -8,7 +8,7 @@ defaults' table (``docs/paper_table1/table1.csv``) and the paper-conditions tabl
 sim=pybullet detector=vision), and writes ``vs_paper.md`` and ``.csv``:
 per cell both of our means with their 95% CIs and their differences from the paper (in
 percentage points), and per table the mean absolute difference and how many paper values
-fall inside our CI.
+fall inside our CI (:func:`versus`, which docs/fidelity/compare.py reuses).
 """
 
 from __future__ import annotations
@@ -35,15 +35,17 @@ def table(path: Path) -> dict[tuple, dict]:
         return {(r["map"], float(r["speed_ratio"]), r["pairing"]): r for r in csv.DictReader(handle)}
 
 
-def main() -> int:
-    paper = table(HERE / "paper_table1.csv")
-    ours = {"defaults": table(DOCS / "paper_table1" / "table1.csv"),
-            "paper_conditions": table(HERE / "table1" / "table1.csv"),
-            "3d_pipeline": table(HERE / "table1_3d" / "table1.csv")}
+def versus(paper: dict[tuple, dict], ours: dict[str, dict[tuple, dict]]) -> tuple[list[dict], dict]:
+    """Each of ``ours`` (a name and its cells, each with ``mean``, ``ci_low`` and
+    ``ci_high``) beside the ``paper``'s cells (``paper_mean``): one row per table and cell,
+    and per table the mean absolute difference, the paper values inside our CI and the
+    cells."""
     rows, summary = [], {}
     for name, cells in ours.items():
         gaps, inside = [], 0
         for key, p in paper.items():
+            if key not in cells:  # a table not played in full
+                continue
             mean, low, high = (float(cells[key][k]) for k in ("mean", "ci_low", "ci_high"))
             target = float(p["paper_mean"])
             gaps.append(abs(mean - target))
@@ -53,6 +55,15 @@ def main() -> int:
                          "ci_high": high, "difference": mean - target,
                          "paper_inside_ci": low <= target <= high})
         summary[name] = (sum(gaps) / len(gaps), inside, len(gaps))
+    return rows, summary
+
+
+def main() -> int:
+    paper = table(HERE / "paper_table1.csv")
+    ours = {"defaults": table(DOCS / "paper_table1" / "table1.csv"),
+            "paper_conditions": table(HERE / "table1" / "table1.csv"),
+            "3d_pipeline": table(HERE / "table1_3d" / "table1.csv")}
+    rows, summary = versus(paper, ours)
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, list(rows[0]), lineterminator="\n")
     writer.writeheader()

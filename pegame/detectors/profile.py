@@ -24,10 +24,13 @@ probability, and it needs nothing the marginal tables do not hold (a joint table
 variables would leave most of its cells empty at the few thousand frames a profile
 has). Its error is where the variables are dependent given the outcome (range and
 visible fraction are: a tilted camera frames less of a near body); the held-out check of
-docs/fidelity measures it. Each bin's rate is Laplace's rule of succession,
-(found + 1) / (frames + 2), so that a bin of all hits or all misses has finite odds; a bin
-without frames, and a lateral speed not yet known (the game's first frame), contribute
-no factor; a value outside the bins falls in the nearest one.
+docs/fidelity measures it. The overall rate is Laplace's rule of succession,
+(found + 1) / (frames + 2), and each bin's the m-estimate of Cestnik (1990, "Estimating
+probabilities: a crucial task in machine learning", ECAI), (found + m p) / (frames + m)
+with m = :data:`PRIOR_FRAMES`: a bin of all hits or all misses has finite odds, and a bin
+of few frames is pulled towards the overall rate (no factor), not towards one half. A bin
+without frames, and a lateral speed not yet known (the game's first frame), contribute no
+factor; a value outside the bins falls in the nearest one.
 
 What the grid knows of the four: the range and bearing from the camera's pose to the
 evader's centre; the visible fraction 1 - :func:`pegame.detectors.perception.hidden_fraction`
@@ -59,6 +62,8 @@ from pegame.errors import ConfigError
 
 #: the profile's variables, in the order :meth:`DetectionProfile.probability` takes them
 VARIABLES = ("range", "bearing", "visible", "lateral_speed")
+#: m of the bins' m-estimate: the overall rate counts as this many frames in every bin
+PRIOR_FRAMES = 2.0
 #: rows of the position error (m) in the line of sight's frame
 ERRORS = ("error_along_mean_m", "error_along_std_m", "error_across_std_m")
 
@@ -140,10 +145,11 @@ class DetectionProfile:
         # every seen frame has a range: the range bins hold the overall rate
         seen = sum(c[2] for c in counts["range"])
         detected = sum(c[3] for c in counts["range"])
-        base = _logit((detected + 1) / (seen + 2))
+        overall = (detected + 1) / (seen + 2)
+        base, m = _logit(overall), PRIOR_FRAMES
         bins = {
             v: tuple(
-                (low, high, _logit((k + 1) / (n + 2)) - base if n else 0.0)
+                (low, high, _logit((k + m * overall) / (n + m)) - base if n else 0.0)
                 for low, high, n, k in counts[v]
             )
             for v in VARIABLES

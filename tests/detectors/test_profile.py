@@ -15,7 +15,7 @@ import pytest
 from pegame.api import Context
 from pegame.detectors.oracle import OracleDetector
 from pegame.detectors.perception import PARTS
-from pegame.detectors.profile import DetectionProfile, profile_names
+from pegame.detectors.profile import PRIOR_FRAMES, DetectionProfile, profile_names
 from pegame.errors import ConfigError
 from pegame.grid import FREE, OccupancyGrid
 from pegame.registry import make_config
@@ -65,30 +65,45 @@ def detections(model: OracleDetector, distance: float, frames: int) -> list:
     ]
 
 
+def rate(found: int, frames: int) -> float:
+    """A bin's rate: the m-estimate towards the overall rate of PROFILE (Laplace's rule)."""
+    overall = 1201 / 2002
+    return (found + PRIOR_FRAMES * overall) / (frames + PRIOR_FRAMES)
+
+
+def combined(*rates: float) -> float:
+    """Naive Bayes: the overall odds times each rate's odds ratio to the overall's."""
+    logit = lambda p: math.log(p / (1 - p))  # noqa: E731
+    base = logit(1201 / 2002)
+    return 1 / (1 + math.exp(-(base + sum(logit(p) - base for p in rates))))
+
+
 def test_the_profile_gives_each_bin_its_rate_and_combines_variables_by_their_odds(profile):
     table = DetectionProfile.read(profile)
-    # one informative variable: its bin's rate (Laplace's rule: (found + 1) / (frames + 2))
-    assert table.probability(1.5, 0.1, 1.0, 0.2) == pytest.approx(901 / 1002)
-    assert table.probability(3.0, 0.1, 1.0, math.nan) == pytest.approx(301 / 1002)
-    assert table.probability(9.0, 0.1, 1.0, 0.2) == pytest.approx(301 / 1002)  # nearest bin
+    flat = rate(1200, 2000)  # the one bin of bearing, visible and lateral speed
+    near, far = combined(rate(900, 1000), flat, flat, flat), combined(rate(300, 1000), flat, flat)
+    assert table.probability(1.5, 0.1, 1.0, 0.2) == pytest.approx(near)
+    assert table.probability(3.0, 0.1, 1.0, math.nan) == pytest.approx(far)  # no lateral factor
+    assert table.probability(9.0, 0.1, 1.0, math.nan) == pytest.approx(far)  # the nearest bin
+    assert near == pytest.approx(0.9, abs=0.002) and far == pytest.approx(0.3, abs=0.002)
     # two informative variables multiply their odds ratios
     two = PROFILE.replace(
         "bearing,0,0.55,2000,0.6", "bearing,0,0.2,1000,0.9\nbearing,0.2,0.55,1000,0.3"
     )
     profile.write_text(two)
-    logit = lambda p: math.log(p / (1 - p))  # noqa: E731
-    base, near = logit(1201 / 2002), logit(901 / 1002)
-    expected = 1 / (1 + math.exp(-(base + 2 * (near - base))))
+    expected = combined(rate(900, 1000), rate(900, 1000), flat, flat)
     assert DetectionProfile.read(profile).probability(1.5, 0.1, 1.0, 0.2) == pytest.approx(expected)
 
 
 def test_detector_profile_detects_at_the_rate_the_profile_gives_the_range(profile):
-    frames = 2000
-    for distance, rate in ((1.5, 901 / 1002), (3.0, 301 / 1002)):
+    frames, table = 2000, DetectionProfile.read(profile)
+    for distance in (1.5, 3.0):
+        chance = table.probability(distance, 0.0, 1.0, 0.0)  # the evader stands still ahead
+        assert chance == pytest.approx(0.9 if distance < 2 else 0.3, abs=0.002)
         seen = detections(detector(profile=str(profile)), distance, frames)
         found = sum(d is not None for d in seen)
-        sigma = math.sqrt(frames * rate * (1 - rate))
-        assert abs(found - frames * rate) < 4 * sigma, (distance, found / frames, rate)
+        sigma = math.sqrt(frames * chance * (1 - chance))
+        assert abs(found - frames * chance) < 4 * sigma, (distance, found / frames, chance)
         # the position carries the profile's bias, 0.2 m beyond the evader's centre
         x = [d.position[0] - CAMERA_POSE.x for d in seen if d is not None]
         assert np.mean(x) == pytest.approx(distance + 0.2, abs=1e-6)
@@ -102,6 +117,7 @@ def test_without_a_profile_the_oracle_detects_every_frame_and_spawns_no_generato
     assert all(d is not None for d in detections(detector(), 3.0, 50))
 
 
+@pytest.mark.slow
 def test_a_profile_with_the_occlusion_miss_or_in_the_batched_env_is_refused(profile):
     from pegame.config import compose
     from pegame.envs.vector import vector_env

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The grid side of the fidelity study (README) and its tables: the 27 Table 1 cells of
+# +experiment=paper_conditions with simultaneous moves (as the 3D side, run3d.sh), n = $N
+# per cell (default 20, seeds 0..N-1: the 3D side's seeds), twice: the oracle with the
+# identified profile $PROFILE (default vision_paper_tilt_160, the 3D side's detector and
+# camera) and occlusion_miss 0 (the profile's visible factor is its occlusion miss), into
+# $OUT/grid; and paper_conditions' own perception model, into $OUT/grid_plain. Then the
+# held-out check of the profile and compare.py's tables (run3d.sh first).
+set -euo pipefail
+OUT=${OUT:-outputs/fidelity}
+N=${N:-20}
+JOBS=${JOBS:-1}
+PROFILE=${PROFILE:-vision_paper_tilt_160}
+COMMON="+experiment=paper_conditions game.turn_order=simultaneous game.trials=$N"
+COMMON="$COMMON hydra.launcher.n_jobs=$JOBS recorder=none"
+run() {  # run <dir> <overrides...>: the three pairings
+  local dir=$1; shift
+  # shellcheck disable=SC2086
+  python -m pegame -m $COMMON "$@" pursuer=smart pursuer.detour=false evader=smart \
+    evader.hide_margin=0 hydra.sweep.dir="$OUT/$dir/S-S" resume=true
+  # shellcheck disable=SC2086
+  python -m pegame -m $COMMON "$@" pursuer=smart pursuer.detour=false evader=random \
+    evader.model=action hydra.sweep.dir="$OUT/$dir/S-R" resume=true
+  # shellcheck disable=SC2086
+  python -m pegame -m $COMMON "$@" pursuer=random pursuer.model=action evader=random \
+    evader.model=action hydra.sweep.dir="$OUT/$dir/R-R" resume=true
+}
+run grid detector.occlusion_miss=0 detector.profile="$PROFILE"
+run grid_plain
+python docs/fidelity/heldout.py
+python docs/fidelity/compare.py "$OUT"
