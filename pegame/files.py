@@ -28,13 +28,21 @@ def write_failed(path: str | os.PathLike, exc: OSError) -> ResultsWriteError:
 
 
 def write_atomic(
-    path: str | os.PathLike, data: str | bytes, staging: str | os.PathLike | None = None
+    path: str | os.PathLike,
+    data: str | bytes,
+    staging: str | os.PathLike | None = None,
+    sync: bool = True,
 ) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same directory, then
     rename it into place (atomic on POSIX), so ``path`` is either absent, old or complete:
-    the rename comes after the data was written, synced to disk and its size checked.
-    ``staging``: the temporary file's path (a recording's ``.rrd.partial``), by default a
-    new hidden name. ResultsWriteError when any of it fails (the temporary file is removed)."""
+    the rename comes after the data was written, synced to disk (unless ``sync`` is
+    False) and its size checked. ``staging``: the temporary file's path (a recording's
+    ``.rrd.partial``), by default a new hidden name. ResultsWriteError when any of it
+    fails (the temporary file is removed).
+
+    Without ``sync`` the file is complete for every reader and survives a killed process
+    (the kernel holds the bytes), but not a crash of the machine before the kernel writes
+    them back: the durability of :func:`append_line`, which ``results.jsonl`` has."""
     path = Path(path)
     raw = data.encode() if isinstance(data, str) else data
     tmp: str | None = None
@@ -47,7 +55,8 @@ def write_atomic(
         with os.fdopen(fd, "wb") as handle:
             handle.write(raw)
             handle.flush()
-            os.fsync(handle.fileno())
+            if sync:
+                os.fsync(handle.fileno())
             written = os.fstat(handle.fileno()).st_size
         if written != len(raw):
             raise OSError(f"{written} of {len(raw)} bytes written")

@@ -4,7 +4,8 @@
 ``rerun.RecordingStream`` (never the global stream) into memory (a ``rerun.BinaryStream``,
 plus a live viewer with ``spawn=true``) while the game runs; :meth:`~RerunRecorder.finish`
 closes it and writes its bytes to ``<game_id>.rrd.partial``, renamed to ``<game_id>.rrd``
-once written, synced and of the right size (:func:`pegame.files.write_atomic`);
+once written and of the right size (:func:`pegame.files.write_atomic`, not synced: see
+:mod:`pegame.recorders.files`);
 :meth:`~RerunRecorder.abort` (a game that raised) sends what it holds, an ERROR event and
 the error, and writes ``<game_id>.failed.rrd`` the same way (see
 :mod:`pegame.recorders.files`). A game killed before its end leaves no recording.
@@ -240,7 +241,7 @@ class RerunRecorder(Recorder):
             raise ResultsWriteError(f"Could not write the recording {final}: {exc}") from None
         finally:
             rec.disconnect()
-        write_atomic(final, data or b"", staging=self.path)
+        write_atomic(final, data or b"", staging=self.path, sync=False)
         self.path = final
 
     def _fail(self, action: str, exc: Exception) -> None:
