@@ -121,6 +121,8 @@ def main(argv: list[str]) -> int:
     values["heldout_brier_base"] = f"{heldout['brier_base']:.4f}"
     for name, title in (("grid_vs_3d", "grid_profile"), ("plain_vs_3d", "grid_plain")):
         rows = compare(rates[title], rates["3d_pipeline"])
+        if not rows:  # not played yet
+            continue
         text, csv_text = render(rows, f"The grid ({title}) against the 3D pipeline", SCRIPT)
         write_atomic(HERE / f"{name}.md", text)
         write_atomic(HERE / f"{name}.csv", csv_text)

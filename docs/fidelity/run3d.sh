@@ -8,6 +8,7 @@
 # grid plays (vision_paper_tilt_160) is identified at the same camera. Writes into $OUT/3d
 # (default outputs/fidelity). DETECTOR=person plays the person detector instead, at 320x240
 # and the tilt $TILT (default 0: level, where it detects at all), into $OUT/3d_person.
+# PAIRINGS (default "S-S S-R R-R") picks pairings, e.g. for a second process.
 set -euo pipefail
 OUT=${OUT:-outputs/fidelity}
 N=${N:-20}
@@ -27,6 +28,12 @@ run() {  # run <pairing> <overrides...>
   # shellcheck disable=SC2086
   python -m pegame -m $COMMON "$@" hydra.sweep.dir="$DIR/$dir" resume=true
 }
-run S-S pursuer=smart pursuer.detour=false evader=smart evader.hide_margin=0
-run S-R pursuer=smart pursuer.detour=false evader=random evader.model=action
-run R-R pursuer=random pursuer.model=action evader=random evader.model=action
+declare -A AGENTS=(
+  [S-S]="pursuer=smart pursuer.detour=false evader=smart evader.hide_margin=0"
+  [S-R]="pursuer=smart pursuer.detour=false evader=random evader.model=action"
+  [R-R]="pursuer=random pursuer.model=action evader=random evader.model=action"
+)
+for pairing in ${PAIRINGS:-S-S S-R R-R}; do
+  # shellcheck disable=SC2086
+  run "$pairing" ${AGENTS[$pairing]}
+done
