@@ -1,11 +1,12 @@
 """The detection profile of a 3D detector, measured on played games (system identification).
 
 ``python -m pegame_vision.profile [--detector person] [--envs enclosed hall brick]
-[--seeds 2] [--first-seed 0] [--t-max 60] [--out DIR] [overrides]`` plays S-S games in PyBullet driven by
+[--seeds 2] [--first-seed 0] [--t-max 60] [--match iou] [--out DIR] [overrides]`` plays S-S games in PyBullet driven by
 ``detector=segmentation`` with the detector under test judged beside it
 (:func:`pegame_vision.evaluate.judged_game`), and measures on every frame on which the
-reference sees the evader how often the detector finds it (box IoU >= 0.5 with the
-reference's), as a function of
+reference sees the evader how often the detector finds it (``--match iou``: box IoU >= 0.5
+with the reference's; ``--match any``: it reports a detection at all, which is what a game
+counts, the world holding one person), as a function of
 
 - ``range``: the evader's horizontal distance from the camera (m);
 - ``bearing``: the absolute angle between the camera's heading and the evader (rad);
@@ -24,7 +25,8 @@ rate, the position error and the CPU time as rows of variable ``false_detection`
 ``position_error_m``, ``error_along_mean_m``, ``error_along_std_m``, ``error_across_std_m``
 and ``cpu_ms``), ``<detector>.md`` (the tables and the command and commit that made them)
 and ``<detector>_frames.csv`` (one row per frame: env, seed, the four variables, seen,
-found; what :mod:`pegame.detectors.profile` is checked against on held-out seeds,
+found (IoU) and reported; what :mod:`pegame.detectors.profile` is checked against on
+held-out seeds,
 ``--first-seed``) into ``--out``.
 """
 
@@ -89,7 +91,7 @@ def frames(
                 bearing = abs(math.remainder(math.atan2(dy, dx) - camera.theta, math.tau))
                 found = seen is not None and truth is not None and iou(truth.box, seen.box) >= IOU
                 error = along = across = None
-                if found and seen is not None:
+                if seen is not None and truth is not None:  # the error of any detection
                     ex, ey = seen.position[0] - evader.x, seen.position[1] - evader.y
                     error = math.hypot(ex, ey)
                     if distance > 1e-9:  # the error in the line of sight's frame
@@ -115,30 +117,32 @@ def frames(
     return records
 
 
-def profile_rows(records: list[dict[str, Any]], cpu: list[float]) -> list[tuple[Any, ...]]:
+def profile_rows(
+    records: list[dict[str, Any]], cpu: list[float], hit: str = "found"
+) -> list[tuple[Any, ...]]:
     """(variable, low, high, frames, value) rows: per variable and bin, the frames on which
-    the reference saw the evader and the fraction the detector found; then the false
-    detections per frame the reference saw nothing on, the median position error (m), the
-    mean and std of its component along the line of sight and the std across it (m), and
-    the median CPU time per frame (ms), each over all frames (low and high empty)."""
+    the reference saw the evader and the fraction of them that are a ``hit`` (``found``: IoU
+    matched; ``reported``: any detection); then the false detections per frame the
+    reference saw nothing on, the median position error (m) of the hits, the mean and std
+    of its component along the line of sight and the std across it (m), and the median CPU
+    time per frame (ms), each over all frames (low and high empty)."""
     rows: list[tuple[Any, ...]] = []
     seen = [r for r in records if r["seen"]]
+    hits = [r for r in seen if r[hit]]
     for variable, edges in EDGES.items():
         for low, high in zip(edges[:-1], edges[1:]):
-            inside = [
-                r["found"] for r in seen if r[variable] is not None and low <= r[variable] < high
-            ]
+            inside = [r[hit] for r in seen if r[variable] is not None and low <= r[variable] < high]
             rows.append(
                 (variable, low, high, len(inside), float(np.mean(inside)) if inside else None)
             )
     empty = [r["reported"] for r in records if not r["seen"]]
-    errors = [r["error"] for r in seen if r["error"] is not None]
+    errors = [r["error"] for r in hits if r["error"] is not None]
     rows.append(("false_detection", "", "", len(empty), float(np.mean(empty)) if empty else None))
     rows.append(
         ("position_error_m", "", "", len(errors), float(np.median(errors)) if errors else None)
     )
-    along = [r["along"] for r in seen if r["along"] is not None]
-    across = [r["across"] for r in seen if r["across"] is not None]
+    along = [r["along"] for r in hits if r["along"] is not None]
+    across = [r["across"] for r in hits if r["across"] is not None]
     for name, values, statistic in (
         ("error_along_mean_m", along, np.mean),
         ("error_along_std_m", along, np.std),
@@ -168,6 +172,9 @@ def main(argv: list[str] | None = None) -> Path:
     parser.add_argument("--seeds", type=int, default=2, help="games per map")
     parser.add_argument("--first-seed", type=int, default=0, help="seeds first..first+N-1")
     parser.add_argument("--t-max", type=float, default=60.0, help="s per game")
+    parser.add_argument(
+        "--match", choices=("iou", "any"), default="iou", help="a hit: IoU >= 0.5, or any detection"
+    )
     parser.add_argument("--out", type=Path, default=Path("."), help="directory of the profile")
     parser.add_argument(
         "overrides", nargs="*", help="game config overrides, e.g. sim.camera_tilt=0"
@@ -182,7 +189,7 @@ def main(argv: list[str] | None = None) -> Path:
     cpu: list[float] = []
     seeds = range(args.first_seed, args.first_seed + args.seeds)
     records = frames(args.detector, args.envs, seeds, args.t_max, args.overrides, cpu)
-    rows = profile_rows(records, cpu)
+    rows = profile_rows(records, cpu, "found" if args.match == "iou" else "reported")
     csv = "variable,low,high,frames,p_detect\n" + "".join(
         ",".join(_cell(v) for v in row) + "\n" for row in rows
     )
@@ -203,7 +210,7 @@ def main(argv: list[str] | None = None) -> Path:
     args.out.mkdir(parents=True, exist_ok=True)
     write_atomic(args.out / f"{args.detector}.csv", csv)
     write_atomic(args.out / f"{args.detector}.md", text)
-    columns = ("env", "seed", *EDGES, "seen", "found")
+    columns = ("env", "seed", *EDGES, "seen", "found", "reported")
     write_atomic(
         args.out / f"{args.detector}_frames.csv",
         ",".join(columns)
