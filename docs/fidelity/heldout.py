@@ -4,10 +4,11 @@
 
 PROFILE_CSV (default: pegame-vision's ``profiles/paper_tilt_160/vision.csv``, seeds 0-1)
 is the identified profile the grid plays; FRAMES_CSV (default ``heldout/vision_frames.csv``
-beside this script: ``python -m pegame_vision.profile --first-seed 2``, seeds
+beside this script: ``python -m pegame_vision.profile --match any --first-seed 2``, seeds
 2-3, other games than the profile's) holds one row per 3D frame with its range, bearing,
-visible fraction, lateral speed and whether the detector found the evader the reference
-saw. For every frame the reference saw, the profile's chance
+visible fraction, lateral speed and whether the detector reported the evader the
+reference saw (the profile is made with ``--match any``: a game counts any detection,
+the world holding one person). For every frame the reference saw, the profile's chance
 (:meth:`pegame.detectors.profile.DetectionProfile.probability`, naive Bayes over the four
 marginal tables, the 3D visible fraction as measured) is set beside the outcome: per
 variable and bin the measured rate and the mean predicted chance, and over all frames both
@@ -48,7 +49,7 @@ def main(argv: list[str]) -> int:
     with frames_csv.open(newline="") as handle:
         seen = [r for r in csv.DictReader(handle) if r["seen"] == "True"]
     values = [[number(r[v]) for v in VARIABLES] for r in seen]
-    found = [r["found"] == "True" for r in seen]
+    found = [r["reported"] == "True" for r in seen]
     predicted = [profile.probability(*v) for v in values]
     base = 1 / (1 + math.exp(-profile.base))
     rows = []

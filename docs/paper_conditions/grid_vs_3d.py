@@ -42,7 +42,8 @@ def compare(grid: dict[tuple, float], three_d: dict[tuple, float]) -> list[dict]
             for pairing in PAIRINGS:
                 pick = lambda rates: {k[3]: v for k, v in rates.items() if k[:3] == (map_name, ratio, pairing)}  # noqa: E731
                 a, b = pick(grid), pick(three_d)
-                if not a or not b:
+                a, b = ({s: v for s, v in x.items() if s in a and s in b} for x in (a, b))  # common seeds
+                if not a:
                     continue
                 test = paired_test(a, b, "two-sided")
                 grid_ci, three_d_ci = bootstrap_ci(list(a.values())), bootstrap_ci(list(b.values()))

@@ -18,11 +18,14 @@ growing with range (Khoshelham & Elberink 2012) and bearing noise, both entering
 the box is drawn, and false positives. The independent miss and the depth noise draw from
 the detector's own generator, two numbers for every evader in view, as they always have;
 the other parts from their own generators, only when they are on. With a profile
-(``detector.profile``, :mod:`pegame.detectors.profile`) an evader in view and in range is
+(``detector.profile``, :mod:`pegame.detectors.profile`) an evader any part of whose body
+is in view (:func:`pegame.visibility.body_in_view`, the frames the profile's reference
+sees: a 3D detector finds a body whose centre has left the image's edge) and in range is
 detected with the profile's chance for its range, bearing, visible fraction and lateral
-speed relative to the camera (from the previous call's poses), and its position carries
-the profile's error: one uniform and two normal draws from the profile's generator per
-such frame.
+speed relative to the camera (from the previous call's poses), and its position is the
+evader's centre moved by the profile's error (measured from the centre); one uniform and
+two normal draws from the profile's generator per such frame. The box and depth are the
+pinhole ones of the centre, clipped to the image.
 """
 
 from __future__ import annotations
@@ -102,8 +105,17 @@ class OracleDetector(Detector):
         positives)."""
         cam, evader = frame.camera_pose, frame.evader_truth
         camera, cfg, perception = self.context.camera, self.config, self.perception
-        if evader is None or not in_view(self.context.grid, camera, cam, (evader.x, evader.y)):
+        if evader is None:
             return None
+        grid, profile = self.context.grid, perception.profile
+        if profile is None:
+            if not in_view(grid, camera, cam, (evader.x, evader.y)):
+                return None
+        else:  # any part of the body in view, as the profile's reference sees it
+            radius = self.context.evader.radius
+            visible = 1.0 - hidden_fraction(grid, camera, cam, (evader.x, evader.y), radius)
+            if visible == 0.0:
+                return None
         distance = cam.distance_to(evader)
         if not perception.in_range(distance):
             return None
@@ -111,10 +123,7 @@ class OracleDetector(Detector):
         miss, noise = self.rng.random(), self.rng.normal(0.0, 1.0)
         if miss < cfg.miss_probability:
             return None
-        profile = perception.profile
         if profile is not None:
-            grid, radius = self.context.grid, self.context.evader.radius
-            visible = 1.0 - hidden_fraction(grid, camera, cam, (evader.x, evader.y), radius)
             bearing = abs(wrap_angle(math.atan2(evader.y - cam.y, evader.x - cam.x) - cam.theta))
             chance = profile.probability(distance, bearing, visible, self._lateral)
             if perception.profile_rng.random() >= chance:
@@ -141,9 +150,9 @@ class OracleDetector(Detector):
         seen_range = depth / math.cos(seen_bearing)
         heading = cam.theta + seen_bearing
         position = (cam.x + seen_range * math.cos(heading), cam.y + seen_range * math.sin(heading))
-        if profile is not None:  # the profile's error in the line of sight's frame
+        if profile is not None:  # the centre and the profile's error, measured from it
             along, across = profile.position_error(perception.profile_rng)
             sight = math.atan2(evader.y - cam.y, evader.x - cam.x)
             c, s = math.cos(sight), math.sin(sight)
-            position = (position[0] + along * c - across * s, position[1] + along * s + across * c)
+            position = (evader.x + along * c - across * s, evader.y + along * s + across * c)
         return Detection(box=box, depth=depth, position=position)

@@ -32,17 +32,20 @@ of few frames is pulled towards the overall rate (no factor), not towards one ha
 without frames, and a lateral speed not yet known (the game's first frame), contribute no
 factor; a value outside the bins falls in the nearest one.
 
-What the grid knows of the four: the range and bearing from the camera's pose to the
-evader's centre; the visible fraction 1 - :func:`pegame.detectors.perception.hidden_fraction`
+What the grid knows of the four, on the frames on which any part of the evader's body is
+in view (:func:`pegame.visibility.body_in_view`: the profile's frames are those on which
+the reference sees evader pixels, its centre out of the image on some): the range and
+bearing from the camera's pose to the evader's centre; the visible fraction
+1 - :func:`pegame.detectors.perception.hidden_fraction`
 (the silhouette points across the line of sight, :data:`pegame.visibility.SILHOUETTE`; the
 3D one also counts the body's height outside the image, which the range factor carries
 where the camera is tilted); the evader's speed across the line of sight relative to the
 camera, from the poses of the detector's previous call (one control tick before, as the
 profile's frames are).
 
-The position error: a found detection's position moves by the profile's mean error along
-the line of sight (its bias; positive beyond the evader's centre) plus Gaussian errors of
-its along and across standard deviations (m). The box and depth are the noise-free ones.
+The position error: a detection is placed at the evader's centre moved by the profile's
+mean error along the line of sight (its bias; positive beyond the centre) plus Gaussian
+errors of its along and across standard deviations (m).
 The latency is not the profile's: the 3D simulator waits for its detector, so the CPU time
 the profile measured (``cpu_ms``) delays nothing in a game's time, and both simulators
 deliver ``detector.latency`` s after capture.

@@ -151,3 +151,15 @@ def test_an_unknown_profile_name_exits_2_with_one_paragraph_naming_the_allowed(t
     assert "'detector.profile': 'nope'" in message and "null (no profile)" in message
     assert all(name in message for name in profile_names())
     assert "Traceback" not in proc.stderr
+
+
+def test_with_a_profile_a_body_whose_centre_left_the_view_is_still_detected(profile):
+    """The profile's frames are those on which any of the body shows (a 3D detector finds
+    legs at the image's edge); the oracle without one tests the centre."""
+    bearing = 0.5 * CAMERA.fov + 0.05  # the centre out of view, the near edge inside
+    evader = Pose(CAMERA_POSE.x + 1.5 * math.cos(bearing), CAMERA_POSE.y + 1.5 * math.sin(bearing))
+    frames = [SensorFrame(0.1 * k, CAMERA_POSE, evader) for k in range(400)]
+    with_profile, plain = detector(profile=str(profile)), detector()
+    found = sum(with_profile.detect(f) is not None for f in frames)
+    assert abs(found - 0.9 * 400) < 4 * math.sqrt(400 * 0.9 * 0.1)
+    assert all(plain.detect(f) is None for f in frames)

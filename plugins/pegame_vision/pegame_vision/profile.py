@@ -49,7 +49,8 @@ from pegame_vision.evaluate import iou, judged_game
 #: bin edges per variable
 EDGES: dict[str, tuple[float, ...]] = {
     "range": (0.0, 1.0, 2.0, 3.0, 4.0, 5.0),
-    "bearing": (0.0, 0.1, 0.2, 0.3, 0.55),
+    # beyond pi/6, half the paper's FOV, the evader's centre is out of view, not its body
+    "bearing": (0.0, 0.1, 0.2, 0.3, 0.4, math.pi / 6, 1.0),
     "visible": (0.0, 0.1, 0.3, 0.6, 1.0001),
     "lateral_speed": (0.0, 0.1, 0.3, 0.6, 10.0),
 }
