@@ -140,6 +140,10 @@ def main(argv: list[str]) -> int:
     values["heldout_predicted"] = f"{100 * heldout['predicted']:.1f}%"
     values["heldout_brier"] = f"{heldout['brier']:.4f}"
     values["heldout_brier_base"] = f"{heldout['brier_base']:.4f}"
+    values["heldout_iou"] = f"{100 * heldout['found_iou']:.1f}%"
+    values["heldout_edge"] = f"{heldout['edge_frames']} of {heldout['frames']}"
+    values["heldout_edge_rate"] = f"{100 * heldout['edge_rate']:.0f}%"
+    values["heldout_edge_max"] = f"{heldout['edge_max_bearing']:.2f} rad"
     for name, title in (("grid_vs_3d", "grid_profile"), ("plain_vs_3d", "grid_plain")):
         rows = compare(rates[title], rates["3d_pipeline"])
         if not rows:  # not played yet

@@ -13,7 +13,8 @@ the world holding one person). For every frame the reference saw, the profile's 
 marginal tables, the 3D visible fraction as measured) is set beside the outcome: per
 variable and bin the measured rate and the mean predicted chance, and over all frames both
 rates, the Brier score of the profile and of the constant overall rate of the profile's
-own frames (the model without any variable). Writes ``heldout.md``, ``.csv`` and
+own frames (the model without any variable); and the share of frames IoU-matched, and
+the frames with the evader's centre outside the pi/3 FOV with their hit rate. Writes ``heldout.md``, ``.csv`` and
 ``.json`` (the overall figures, which compare.py quotes in README.md) beside this script.
 """
 
@@ -81,8 +82,13 @@ def main(argv: list[str]) -> int:
               f"overall rate {base:.3f})."]
     write_atomic(HERE / "heldout.md", "\n".join(lines) + "\n")
     write_atomic(HERE / "heldout.csv", buffer.getvalue())
+    # frames with the evader's centre out of the FOV (bearing beyond pi/6), its body not
+    edge = [k for k, v in enumerate(values) if v[1] > math.pi / 6]
     summary = {"frames": n, "measured": overall["measured"], "predicted": overall["predicted"],
-               "brier": brier, "brier_base": brier_base, "base": base}
+               "brier": brier, "brier_base": brier_base, "base": base,
+               "found_iou": sum(r["found"] == "True" for r in seen) / n,
+               "edge_frames": len(edge), "edge_rate": sum(found[k] for k in edge) / max(1, len(edge)),
+               "edge_max_bearing": max((values[k][1] for k in edge), default=math.nan)}
     write_atomic(HERE / "heldout.json", json.dumps(summary, indent=1) + "\n")
     print("\n".join(lines))
     return 0
