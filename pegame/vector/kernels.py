@@ -1,7 +1,8 @@
 """Numba kernels of the batched game: one control tick of many games at once.
 
-Each kernel loops over the games, from PARALLEL_GAMES games on with ``prange`` (numba's
-thread pool, across cores: ``NUMBA_NUM_THREADS`` sets how many); inside a game the work
+Each kernel loops over the games with ``prange``, from PARALLEL_GAMES games on on numba's
+thread pool (across cores: ``NUMBA_NUM_THREADS`` sets how many), below on one thread
+(:func:`threaded`); inside a game the work
 is the single game's, in the same order and with the same float operations, so a game
 played here is the game the plain-Python code plays (``tests/test_vector_env.py``
 compares them step by step):
@@ -19,7 +20,9 @@ compares them step by step):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
+import numba
 import numpy as np
 from numba import njit, prange
 
@@ -129,22 +132,8 @@ def _play_game(
         state.rewards[game] += state.detected[game]
 
 
-@njit(cache=True)
-def _play_serial(
-    world: World,
-    rules: Rules,
-    state: BatchState,
-    playing: np.ndarray,
-    ticks: int,
-    table: np.ndarray,
-    table_role: int,
-) -> None:
-    for game in range(playing.size):
-        _play_game(world, rules, state, game, playing, ticks, table, table_role)
-
-
 @njit(cache=True, parallel=True)
-def _play_parallel(
+def _play(
     world: World,
     rules: Rules,
     state: BatchState,
@@ -155,6 +144,42 @@ def _play_parallel(
 ) -> None:
     for game in prange(playing.size):
         _play_game(world, rules, state, game, playing, ticks, table, table_role)
+
+
+@njit(cache=True)
+def _sense_game(world: World, rules: Rules, state: BatchState, game: int) -> None:
+    """:func:`sense` of one game, a function of its own: inlined into the ``prange`` loop,
+    numba's parallel transforms change what it computes (tests/envs/test_vector.py)."""
+    sense(world, rules, state, game)
+
+
+@njit(cache=True, parallel=True)
+def _sense(world: World, rules: Rules, state: BatchState, games: np.ndarray) -> None:
+    for k in prange(games.size):
+        _sense_game(world, rules, state, games[k])
+
+
+def threaded(kernel: Callable[..., None], games: int, *args: object) -> None:
+    """Call the ``prange`` kernel ``kernel`` with ``args``: on numba's threads from
+    PARALLEL_GAMES ``games`` on, below on one thread (no thread start-up; the count set is
+    the calling thread's). A parallel loop on one thread and not a serial kernel: a
+    ``prange`` body does no reference counting, which the same loop in a plain kernel
+    pays per array of the NamedTuples per game (the tick, one thread, CPU time: 1.61 us
+    per game in a serial loop, 0.92 in the parallel one at 64 games, 2.26 and 1.60 at 8;
+    0.3 us more per call at one game, 3 us more with two threads, which are set and reset;
+    docs/performance/vmas.md). The count is set here, not in the kernels: numba caches no
+    kernel that sets it. (The features' loop takes its arrays out once per block of games:
+    a serial loop costs it nothing.)"""
+    one = numba.config.NUMBA_NUM_THREADS == 1  # type: ignore[attr-defined]  # no stubs
+    if games >= PARALLEL_GAMES or one:
+        kernel(*args)
+        return
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        kernel(*args)
+    finally:
+        numba.set_num_threads(threads)
 
 
 def play(
@@ -170,28 +195,9 @@ def play(
     set, each stopping at its last tick; state.rewards counts the detections. ``table``
     (N, decisions, 2): the (v, w) commands of a scripted role ``table_role`` (-1: none) per
     decision. Parallel over games from PARALLEL_GAMES games on."""
-    kernel = _play_parallel if playing.size >= PARALLEL_GAMES else _play_serial
-    kernel(world, rules, state, playing, ticks, table, table_role)
-
-
-@njit(cache=True)
-def _sense_game(world: World, rules: Rules, state: BatchState, game: int) -> None:
-    sense(world, rules, state, game)
-
-
-@njit(cache=True)
-def _sense_serial(world: World, rules: Rules, state: BatchState, games: np.ndarray) -> None:
-    for k in range(games.size):
-        _sense_game(world, rules, state, games[k])
-
-
-@njit(cache=True, parallel=True)
-def _sense_parallel(world: World, rules: Rules, state: BatchState, games: np.ndarray) -> None:
-    for k in prange(games.size):
-        _sense_game(world, rules, state, games[k])
+    threaded(_play, playing.size, world, rules, state, playing, ticks, table, table_role)
 
 
 def sense_games(world: World, rules: Rules, state: BatchState, games: np.ndarray) -> None:
     """:func:`sense` for the games listed in ``games`` (int (K,)), e.g. just reset."""
-    kernel = _sense_parallel if games.size >= PARALLEL_GAMES else _sense_serial
-    kernel(world, rules, state, games)
+    threaded(_sense, games.size, world, rules, state, games)
