@@ -7,6 +7,7 @@ reader of rerun-sdk (``rerun.chunk.RrdReader``), counting each entity's rows on 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import subprocess
 import sys
@@ -22,6 +23,7 @@ from pegame.game import Game
 from pegame.grid import OccupancyGrid
 from pegame.losses import OCCLUDED, Loss
 from pegame.recorders.rerun import RerunRecorder, recording_id
+from pegame.recorders.rerun.scene import HEAVY_PARTICLE
 from pegame.replay import find_recordings
 from pegame.types import (
     Belief,
@@ -466,6 +468,36 @@ def test_particles_are_subsampled_and_coloured_by_weight(tmp_path):
     colors = batch.column("Points3D:colors").to_pylist()[0]
     assert len(positions) == len(colors) == 100
     assert len(set(colors)) > 10
+
+
+def test_particles_of_equal_weight_are_sent_with_one_colour(tmp_path):
+    """After a resampling every weight is equal: the row holds one colour, which Rerun
+    repeats over its points (the heaviest shade, as each point had before)."""
+    from rerun.chunk import RrdReader
+
+    context = small_context()
+    recorder = RerunRecorder(RerunRecorder.Config(max_particles=100), context, None)
+    recorder.start(str(tmp_path), "game", {})
+    weighted, resampled = synthetic_ticks(context, 2)
+    n = len(resampled.belief.particles)
+    equal = Belief(
+        resampled.belief.mean, particles=resampled.belief.particles, weights=np.full(n, 1.0 / n)
+    )
+    for tick in (weighted, dataclasses.replace(resampled, belief=equal)):
+        recorder.log(tick)
+    recorder.finish({})
+    (chunk,) = [
+        c
+        for c in RrdReader(tmp_path / "game.rrd").stream().to_chunks()
+        if c.entity_path == "/world/belief/particles" and not c.is_static
+    ]
+    batch = chunk.to_record_batch()
+    positions = batch.column("Points3D:positions").to_pylist()
+    colors = batch.column("Points3D:colors").to_pylist()
+    assert [len(p) for p in positions] == [100, 100]
+    assert len(colors[0]) == 100 and len(set(colors[0])) > 10
+    r, g, b, a = HEAVY_PARTICLE.astype(int)
+    assert colors[1] == [r << 24 | g << 16 | b << 8 | a]
 
 
 def test_recording_id_is_deterministic_per_place_and_config(tmp_path):

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from itertools import chain
 from typing import Any, Protocol
 
 import numpy as np
@@ -74,7 +75,8 @@ def tick_row(tick: Tick, rate: float) -> tuple:
 
 def row_columns(rows: list[tuple]) -> dict[str, np.ndarray]:
     """Buffered :func:`tick_row` rows as one float array per :data:`ROW` name."""
-    return dict(zip(ROW, np.array(rows, dtype=float).T))
+    flat = np.fromiter(chain.from_iterable(rows), dtype=float, count=len(rows) * len(ROW))
+    return dict(zip(ROW, flat.reshape(len(rows), len(ROW)).T))
 
 
 class Archetype(Protocol):
@@ -170,14 +172,14 @@ def points_at(xy: ArrayLike, z: float) -> np.ndarray:
 
 class ParticleRows:
     """The particle subsamples of up to ``capacity`` ticks, at most ``limit`` particles per
-    tick (an evenly strided subsample), in arrays allocated once: map-frame positions (m)
-    as float32 points at height ``z``, and their weights (NaN where the estimator gives
-    none)."""
+    tick (an evenly strided subsample), in arrays allocated once and touched only where
+    rows are written: map-frame positions (m) as float32 points at height ``z``, and their
+    weights as float32 (NaN where the estimator gives none; they only set a shade)."""
 
     def __init__(self, capacity: int, limit: int, z: float) -> None:
-        self.limit = limit
-        self.xyz = np.full((capacity, limit, 3), z, dtype=np.float32)
-        self.weights = np.zeros((capacity, limit))
+        self.limit, self.z = limit, z
+        self.xy = np.empty((capacity, limit, 2), dtype=np.float32)
+        self.weights = np.empty((capacity, limit), dtype=np.float32)
         self.sizes = np.zeros(capacity, dtype=np.int64)
         self.steps = np.zeros(capacity, dtype=np.int64)
         self.times = np.zeros(capacity)
@@ -196,15 +198,18 @@ class ParticleRows:
         if particles is not None:
             stride = -(-len(particles) // self.limit) or 1
             size = -(-len(particles) // stride)
-            self.xyz[row, :size, :2] = particles[::stride, :2]
+            self.xy[row, :size] = particles[::stride, :2]
             self.weights[row, :size] = np.nan if weights is None else weights[::stride]
         self.sizes[row], self.steps[row], self.times[row] = size, step, time
         self.count += 1
 
-    def take(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Empty the rows: (steps (T,), times (T,) s, positions (M, 3), shades (M,) uint8,
-        sizes (T,)), the rows' particles one after the other. A shade is 255 * the weight
-        over its tick's largest weight, rounded; 128 where the weight is NaN."""
+    def take(self) -> tuple[np.ndarray, ...]:
+        """Empty the rows: (steps (T,), times (T,) s, positions (M, 3), sizes (T,), shades
+        (S,) uint8, shade counts (T,)), the rows' particles one after the other. A shade
+        is 255 * the weight over its tick's largest weight, rounded; 128 where the weight
+        is NaN. A row whose particles all have one shade (equal weights, as after a
+        resampling) gives that shade once: Rerun repeats a row's last colour over its
+        points, so the viewer shows the same colours."""
         n, self.count = self.count, 0
         sizes, weights = self.sizes[:n].copy(), self.weights[:n]
         held = np.arange(self.limit) < sizes[:, None]
@@ -213,6 +218,13 @@ class ParticleRows:
         scale = np.divide(255.0, top, out=np.zeros_like(top), where=top > 0)
         shades = np.clip(np.where(unknown, 0.0, weights) * scale + 0.5, 0, 255).astype(np.uint8)
         shades[unknown] = 128
+        first = shades[:, :1]
+        uniform = np.all((shades == first) | ~held, axis=1) & (sizes > 0)
+        coloured = held & ~(uniform[:, None] & (np.arange(self.limit) > 0))
         kept = np.flatnonzero(held)  # take() copies rows several times faster than a bool mask
-        positions = np.take(self.xyz[:n].reshape(-1, 3), kept, axis=0)
-        return self.steps[:n].copy(), self.times[:n].copy(), positions, shades.ravel()[kept], sizes
+        positions = np.empty((len(kept), 3), dtype=np.float32)
+        positions[:, :2] = np.take(self.xy[:n].reshape(-1, 2), kept, axis=0)
+        positions[:, 2] = self.z
+        counts = np.where(uniform, 1, sizes)
+        steps, times = self.steps[:n].copy(), self.times[:n].copy()
+        return steps, times, positions, sizes, shades[coloured], counts

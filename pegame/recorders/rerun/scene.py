@@ -224,7 +224,8 @@ def log_sensing(rec: rr.RecordingStream, c: dict[str, np.ndarray], every: list) 
     sizes = seen.astype(np.int64)
     where = stack_points(c["det_x"][seen], c["det_y"][seen], Z_MARKER)
     _send(rec, "world/detection", every, rr.Points3D.columns(positions=where).partition(sizes))
-    labels = [f"evader {p:.2f}, {d:.2f} m" for p, d in zip(c["confidence"][seen], c["depth"][seen])]
+    seen_at = zip(c["confidence"][seen].tolist(), c["depth"][seen].tolist())
+    labels = [f"evader {p:.2f}, {d:.2f} m" for p, d in seen_at]
     boxes = rr.Boxes2D.columns(
         centers=np.column_stack([c["box_cx"][seen], c["box_cy"][seen]]),
         half_sizes=np.column_stack([c["box_hw"][seen], c["box_hh"][seen]]),
@@ -260,14 +261,12 @@ def log_plots(
 def log_particles(rec: rr.RecordingStream, particles: ParticleRows, indexes: dict) -> None:
     """The buffered particle subsamples, one row per tick, coloured by their shade."""
     if particles.count:
-        steps, times, positions, shades, sizes = particles.take()
-        colors = _particle_palette()[shades]
-        _send(
-            rec,
-            "world/belief/particles",
-            time_index(indexes, steps, times),
-            rr.Points3D.columns(positions=positions, colors=colors).partition(sizes),
-        )
+        steps, times, positions, sizes, shades, counts = particles.take()
+        columns = [
+            *rr.Points3D.columns(positions=positions).partition(sizes),
+            *rr.Points3D.columns(colors=_particle_palette()[shades]).partition(counts),
+        ]
+        _send(rec, "world/belief/particles", time_index(indexes, steps, times), columns)
 
 
 @lru_cache(maxsize=1)
