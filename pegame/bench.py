@@ -115,10 +115,16 @@ def bench_sim_steps(grid: OccupancyGrid, steps: int) -> float:
 
 def game_seconds(overrides: list[str], out_dir: str) -> float:
     """Wall-clock time (s) of playing one game (not building it)."""
+    return game_times(overrides, out_dir)[0]
+
+
+def game_times(overrides: list[str], out_dir: str) -> tuple[float, float]:
+    """(wall-clock time, CPU time of the playing thread) (s) of playing one game (not
+    building it). The CPU time leaves out what other processes take of the machine."""
     game = Game(compose(overrides))
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.thread_time()
     game.play(out_dir)
-    return time.perf_counter() - start
+    return time.perf_counter() - start, time.thread_time() - cpu
 
 
 def games_per_second(overrides: list[str], games: int, out_dir: str) -> float:
@@ -204,27 +210,37 @@ def bench_decisions(
     return out
 
 
-def recorder_cost(games: int, out_dir: str) -> tuple[float | None, float | None]:
-    """(fractional extra time of recording an S-S game with recorder=rerun, MB per .rrd).
+def recorder_cost(games: int, out_dir: str) -> dict[str, float | None]:
+    """The cost of recording an S-S game with recorder=rerun: ``recorder_overhead``, its
+    fractional extra wall-clock time, ``recorder_cpu_overhead``, the same in CPU time of
+    the playing thread, and ``rrd_mb_per_game``, the largest .rrd (MB).
 
     Each seed is played without and then with the recorder, one right after the other,
-    and the figure is the median of the per-seed ratios: on a shared machine, neighbouring
-    games see the same load."""
+    and the figures are medians of the per-seed ratios: on a shared machine, neighbouring
+    games see the same load. The CPU time (rerun-sdk encodes the recording on that
+    thread when the game ends) varies less with the load than the wall-clock time."""
+    figures: dict[str, float | None] = dict.fromkeys(
+        ("recorder_overhead", "recorder_cpu_overhead", "rrd_mb_per_game")
+    )
     if not all("smart" in registry.available(g) for g in ("pursuer", "evader")):
-        return None, None
+        return figures
     base = ["pursuer=smart", "evader=smart", "env=enclosed"]
     games_per_second(
         [*base, "recorder=rerun"], 1, out_dir
     )  # imports rerun-sdk, compiles the outline kernel
-    ratios = []
+    walls, cpus = [], []
     for seed in range(games):
         plain, recorded = (
-            game_seconds([*base, f"recorder={recorder}", f"game.seed={seed}"], out_dir)
+            game_times([*base, f"recorder={recorder}", f"game.seed={seed}"], out_dir)
             for recorder in ("none", "rerun")
         )
-        ratios.append(recorded / plain - 1.0)
+        walls.append(recorded[0] / plain[0] - 1.0)
+        cpus.append(recorded[1] / plain[1] - 1.0)
     sizes = [p.stat().st_size for p in Path(out_dir).glob("*.rrd")]
-    return statistics.median(ratios), (max(sizes) / 2**20 if sizes else None)
+    figures["recorder_overhead"] = statistics.median(walls)
+    figures["recorder_cpu_overhead"] = statistics.median(cpus)
+    figures["rrd_mb_per_game"] = max(sizes) / 2**20 if sizes else None
+    return figures
 
 
 class _NoLosses(LossCauses):
@@ -410,7 +426,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         for name, row in per_map.items():
             ss = ["pursuer=smart", "evader=smart", "recorder=none", f"env={name}"]
             row["ss_games_per_s"] = games_per_second(ss, games, tmp) if smart else None
-        report["recorder_overhead"], report["rrd_mb_per_game"] = recorder_cost(3 * games, tmp)
+        report.update(recorder_cost(3 * games, tmp))
         report["team_game_s"] = team_scaling(games, tmp, 30.0 if args.quick else 90.0)
     report["loss_causes_overhead"] = loss_causes_cost(3 * games)
     for key in ("visibility_ms", "distance_field_ms", "plan_ms", "pf_step_ms"):
@@ -468,9 +484,10 @@ def format_report(report: dict[str, Any]) -> str:
         f"90 s games/s (one core): R-R {fmt(report['rr_games_per_s'])} (enclosed), "
         f"S-S {fmt(report['ss_games_per_s'])} (the slowest paper map)"
     )
-    overhead = report["recorder_overhead"]
+    overhead, cpu = report["recorder_overhead"], report.get("recorder_cpu_overhead")
     lines.append(
-        f"recorder: +{fmt(None if overhead is None else 100 * overhead)}% game time, "
+        f"recorder: +{fmt(None if overhead is None else 100 * overhead)}% game time "
+        f"(+{fmt(None if cpu is None else 100 * cpu)}% CPU of the game's thread), "
         f"{fmt(report['rrd_mb_per_game'])} MB per 90 s game"
     )
     losses = report.get("loss_causes_overhead") or {}
