@@ -21,7 +21,9 @@ core: ``NUMBA_NUM_THREADS=1`` (set here before numba loads) and
 - pegame's batched env (:func:`pegame.envs.vector.vector_env`) on a paper map (``--map``,
   default enclosed: the oracle detector's ray-cast occlusion through the map's walls,
   the map crop in the observation), the learning pursuer against the random evader
-  (``evader.model=action``, drawn inside the kernels); both roles learning
+  (``evader.model=action``, drawn inside the kernels), with the default observation
+  (1032 floats: 8 features and the 32 x 32 map crop) and with a crop of one cell
+  (``crop_cells=1``: 9 floats, the size of VMAS's observations); both roles learning
   (``role='both'``); and against the smart evader (its decisions in Python, game by
   game), each round whole decision periods of it (``decide_every`` ticks);
 - VMAS ``simple_tag`` 1v1 (one adversary, one good agent) with its 2 landmarks
@@ -35,7 +37,10 @@ and rewards. Rounds alternate ABAB... (the order reversed every other round) so 
 machine's other load hits every contestant alike; a contestant's steps per round are
 fixed after a warm-up call to last about ``--seconds``. pegame's games are reset
 between rounds, untimed, when one would end inside the next round (VMAS's never end:
-no ``max_steps``). The figures are medians over rounds; a ratio is the median of the
+no ``max_steps``). A round is timed in the process's CPU time
+(``time.process_time``: every thread's, so a helper thread of torch or numba would count),
+which a shared machine's other processes do not stretch as they do wall time; they
+still share the caches. The figures are medians over rounds; a ratio is the median of the
 same rounds' ratios. The results: ``vmas.csv`` (a row per contestant and size),
 ``vmas.json`` (provenance: commit, versions, CPU, load before and after, date) and the
 page ``vmas.md``; README's table is generated from them (``<!-- generated: vmas -->``).
@@ -72,6 +77,8 @@ CSV, PROVENANCE, PAGE, README = (
 SIZES = (1, 64, 1024, 4096)
 #: the contestant whose ratio to each VMAS scenario the tables give
 REFERENCE = "pegame, random evader"
+#: the same with a crop of one cell: an observation of 9 floats (VMAS's: 6 to 19)
+CROPLESS = "pegame, random evader, 1-cell crop"
 COLUMNS = (
     "contestant",
     "num_envs",
@@ -81,6 +88,7 @@ COLUMNS = (
     "rounds",
     "steps_per_round",
     "reference_ratio",
+    "cropless_ratio",
 )
 
 
@@ -120,11 +128,16 @@ class Pegame(Contestant):
         opponent: str | None,
         name: str,
         overrides: tuple[str, ...] = (),
+        **settings: int,
     ) -> None:
         from pegame.envs.vector import vector_env
 
         env = vector_env(
-            num_envs, overrides=[f"env={map_name}", *overrides], opponent=opponent, role=role
+            num_envs,
+            overrides=[f"env={map_name}", *overrides],
+            opponent=opponent,
+            role=role,
+            **settings,
         )
         game = env.game
         self.name, self.env, self.roles = name, env, game.roles
@@ -151,10 +164,10 @@ class Pegame(Contestant):
         single = len(self.roles) == 1
         batches = [b[0] if single else dict(zip(self.roles, b)) for b in draws]
         step = self.env.step
-        start = time.perf_counter()
+        start = time.process_time()
         for batch in batches:
             step(batch)
-        elapsed = time.perf_counter() - start
+        elapsed = time.process_time() - start
         self.played += self.steps
         return self.steps * self.num_envs / elapsed
 
@@ -177,15 +190,24 @@ class Vmas(Contestant):
         batches = [
             [env.get_random_action(agent) for agent in env.agents] for _ in range(self.steps)
         ]
-        start = time.perf_counter()
+        start = time.process_time()
         for batch in batches:
             env.step(batch)
-        return self.steps * self.num_envs / (time.perf_counter() - start)
+        return self.steps * self.num_envs / (time.process_time() - start)
 
 
 def contestants(num_envs: int, map_name: str) -> list[Contestant]:
     return [
         Pegame(num_envs, map_name, "pursuer", "random", REFERENCE, ("evader.model=action",)),
+        Pegame(
+            num_envs,
+            map_name,
+            "pursuer",
+            "random",
+            CROPLESS,
+            ("evader.model=action",),
+            crop_cells=1,
+        ),
         Pegame(num_envs, map_name, "both", None, "pegame, both learning"),
         Pegame(num_envs, map_name, "pursuer", "smart", "pegame, smart evader"),
         Vmas(num_envs, "simple_tag", "VMAS simple_tag 1v1", num_adversaries=1, num_good_agents=1),
@@ -213,7 +235,10 @@ def measure_size(num_envs: int, map_name: str, rounds: int, seconds: float) -> l
     rows = []
     for contestant in field:
         mine = rates[contestant.name]
-        ratios = [r / m for r, m in zip(rates[REFERENCE], mine)]
+        ratios = {
+            name: statistics.median(r / m for r, m in zip(rates[name], mine))
+            for name in (REFERENCE, CROPLESS)
+        }
         rows.append(
             {
                 "contestant": contestant.name,
@@ -223,7 +248,8 @@ def measure_size(num_envs: int, map_name: str, rounds: int, seconds: float) -> l
                 "high": round(max(mine)),
                 "rounds": rounds,
                 "steps_per_round": contestant.steps,
-                "reference_ratio": round(statistics.median(ratios), 3),
+                "reference_ratio": round(ratios[REFERENCE], 3),
+                "cropless_ratio": round(ratios[CROPLESS], 3),
             }
         )
         print(
@@ -323,15 +349,29 @@ def rates_table() -> str:
     return grid(rows, names, lambda r: f"{int(r['steps_per_s']):,}")
 
 
-def ratios_table() -> str:
+def ratios_table(column: str = "reference_ratio") -> str:
+    """pegame's contestant of ``column`` over each VMAS scenario, per size."""
     rows, _ = results()
-    names = list(dict.fromkeys(r["contestant"] for r in rows if r["contestant"].startswith("VMAS")))
-    return grid(rows, names, lambda r: times(float(r["reference_ratio"])))
+    names = [n for n in dict.fromkeys(r["contestant"] for r in rows) if n.startswith("VMAS")]
+    return grid(rows, names, lambda r: times(float(r[column])))
 
 
 def times(ratio: float) -> str:
     """A ratio with two significant digits or whole (``1.7x``, ``0.76x``, ``56x``)."""
     return f"{ratio:.0f}x" if ratio >= 10 else f"{ratio:.2g}x"
+
+
+def profile_table() -> str:
+    """``vmas_profile.csv`` (``vmas_profile.py``): a step's CPU time per game, by part."""
+    with (HERE / "vmas_profile.csv").open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    out = ["| envs | step | tick kernel | observation | rest of the step |", "|---" * 5 + "|"]
+    for r in rows:
+        cells = [f"{int(r['num_envs']):,}"] + [
+            f"{float(r[key]):.2f} us" for key in ("step", "tick", "observation", "rest")
+        ]
+        out.append("| " + " | ".join(cells) + " |")
+    return "\n".join(out)
 
 
 def machine() -> str:
@@ -367,7 +407,12 @@ VALUES = {
     "vmas_map": lambda: results()[1]["map"],
 }
 PAGES = {
-    PAGE: {"vmas_rates": rates_table, "vmas_ratios": ratios_table},
+    PAGE: {
+        "vmas_rates": rates_table,
+        "vmas_ratios": ratios_table,
+        "vmas_cropless": lambda: ratios_table("cropless_ratio"),
+        "vmas_profile": profile_table,
+    },
     README: {"vmas_ratios": ratios_table},
     ROOT / "docs/explanation/performance.md": {},
 }
