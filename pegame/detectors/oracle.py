@@ -23,9 +23,10 @@ is in view (:func:`pegame.visibility.body_in_view`, the frames the profile's ref
 sees: a 3D detector finds a body whose centre has left the image's edge) and in range is
 detected with the profile's chance for its range, bearing, visible fraction and lateral
 speed relative to the camera (from the previous call's poses), and its position is the
-evader's centre moved by the profile's error (measured from the centre); one uniform and
-two normal draws from the profile's generator per such frame. The box and depth are the
-pinhole ones of the centre, clipped to the image.
+evader's centre moved by the profile's error (measured from the centre), its box and
+depth those of a body there; one uniform and two normal draws from the profile's
+generator per such frame (the depth and bearing noise are the profile's error, and
+refused beside it).
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ import numpy as np
 
 from pegame.api import Context, Detector
 from pegame.detectors.perception import Perception, PerceptionConfig, hidden_fraction, pinhole_box
+from pegame.detectors.profile import DetectionProfile
 from pegame.errors import require
 from pegame.types import Detection, Pose, SensorFrame, wrap_angle
 from pegame.visibility import in_view
@@ -135,6 +137,8 @@ class OracleDetector(Detector):
                 hidden = hidden_fraction(grid, camera, cam, (evader.x, evader.y), radius)
             if perception.missed_by_range(distance, hidden):
                 return None
+        if profile is not None:
+            return self._profiled(cam, evader, profile)
         bearing = math.atan2(evader.y - cam.y, evader.x - cam.x) - cam.theta
         bearing = wrap_angle(bearing)
         if cfg.bearing_noise > 0:
@@ -150,9 +154,23 @@ class OracleDetector(Detector):
         seen_range = depth / math.cos(seen_bearing)
         heading = cam.theta + seen_bearing
         position = (cam.x + seen_range * math.cos(heading), cam.y + seen_range * math.sin(heading))
-        if profile is not None:  # the centre and the profile's error, measured from it
-            along, across = profile.position_error(perception.profile_rng)
-            sight = math.atan2(evader.y - cam.y, evader.x - cam.x)
-            c, s = math.cos(sight), math.sin(sight)
-            position = (evader.x + along * c - across * s, evader.y + along * s + across * c)
         return Detection(box=box, depth=depth, position=position)
+
+    def _profiled(self, cam: Pose, evader: Pose, profile: DetectionProfile) -> Detection:
+        """A detected evader under a profile: its centre moved by the profile's error (in
+        the line of sight's frame, measured from the centre), and the box and depth of a
+        body there, so that a pursuer servoing on the box sees the error the 3D detector's
+        box has (its box and position come from the same pixels)."""
+        camera = self.context.camera
+        along, across = profile.position_error(self.perception.profile_rng)
+        sight = math.atan2(evader.y - cam.y, evader.x - cam.x)
+        c, s = math.cos(sight), math.sin(sight)
+        x, y = evader.x + along * c - across * s, evader.y + along * s + across * c
+        distance = max(camera.near, math.hypot(x - cam.x, y - cam.y))
+        bearing = wrap_angle(math.atan2(y - cam.y, x - cam.x) - cam.theta)
+        depth = max(camera.near, distance * math.cos(bearing))
+        cfg, radius = self.config, self.context.evader.radius
+        box = pinhole_box(
+            camera, bearing, distance, depth, radius, cfg.evader_height, cfg.camera_height
+        )
+        return Detection(box=box, depth=depth, position=(x, y))

@@ -168,13 +168,15 @@ class PerceptionConfig:
                 f"the runs between them (burst_length * (1 - f) / f with f = "
                 f"detector.burst_miss_fraction = {f}) of at least one frame, {step:g} s."
             )
-        if self.profile is not None and (not self.occlusion or self.occlusion_miss > 0):
+        noisy = self.range_noise > 0 or self.range_noise_growth > 0 or self.bearing_noise > 0
+        if self.profile is not None and (not self.occlusion or self.occlusion_miss > 0 or noisy):
             allowed = (
                 "null for this detector, which measures its own detections (a profile is the "
                 "oracle's, detector=oracle)"
                 if not self.occlusion
-                else "null, or a profile with detector.occlusion_miss=0 (the profile's "
-                "visible-fraction factor is its occlusion miss)"
+                else "null, or a profile with detector.occlusion_miss, range_noise, "
+                "range_noise_growth and bearing_noise at 0 (the profile's visible-fraction "
+                "factor is its occlusion miss, its position error its noise)"
             )
             raise ConfigError(
                 f"Invalid value for 'detector.profile': {self.profile!r}. Allowed: {allowed}."

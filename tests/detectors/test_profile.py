@@ -124,7 +124,7 @@ def test_a_profile_with_the_occlusion_miss_or_in_the_batched_env_is_refused(prof
     from pegame.game import Scenario
 
     overrides = ["env=enclosed", f"detector.profile={profile}", "detector.occlusion_miss=1"]
-    with pytest.raises(ConfigError, match="detector.occlusion_miss=0"):
+    with pytest.raises(ConfigError, match="detector.occlusion_miss, range_noise"):
         Scenario(compose(overrides))
     with pytest.raises(ConfigError, match="'detector.profile' in a batched env"):
         vector_env(2, overrides=["env=hall", f"detector.profile={profile}"], opponent="random")
