@@ -21,7 +21,8 @@ Workloads, on each map of ``--maps``: ``visibility`` (Algorithm 1 from 50 poses,
 the decisions on their own, 20 each: ``filter`` (particle filter updates, 2000 particles,
 regions given), ``pursuer`` (smart pursuer decisions, each after its filter update),
 ``evader`` (smart evader decisions); ``sim`` (2000 grid-simulator steps), ``game`` (one
-90 s S-S game, seed 0, recorder=none) and ``env`` (one PettingZoo episode of random
+90 s S-S game, seed 0, recorder=none), ``recorded`` (the same game with recorder=rerun:
+its Ir less the game's is the recording's) and ``env`` (one PettingZoo episode of random
 actions, seed 0). A side takes about two minutes a workload; the sides run two at a time
 (``--jobs``).
 """
@@ -46,6 +47,7 @@ WORKLOADS = (
     "evader",
     "sim",
     "game",
+    "recorded",
     "env",
 )
 #: the counts callgrind prints at exit (``==pid== NAME: count``), by our name
@@ -80,9 +82,11 @@ def workload(name: str, map_name: str):
         return _decisions(grid, name)
     if name == "sim":
         return lambda: bench.bench_sim_steps(grid, 2000)
-    if name == "game":
-        overrides = ["recorder=none", f"env={map_name}", "game.seed=0"]
-        return lambda: bench.Game(bench.compose(overrides)).play(tempfile.gettempdir())
+    if name in ("game", "recorded"):
+        recorder = "rerun" if name == "recorded" else "none"
+        overrides = [f"recorder={recorder}", f"env={map_name}", "game.seed=0"]
+        out_dir = tempfile.mkdtemp(prefix="pegame-ab-")
+        return lambda: bench.Game(bench.compose(overrides)).play(out_dir)
     if name == "env":
         from pegame.envs.parallel import parallel_env
 

@@ -23,7 +23,11 @@ Cost. On the grid simulator a control tick takes about 0.3 ms, less than a few
 per-entity buffers (:mod:`.columns`), all sent with ``send_columns`` every
 ``flush_every`` ticks (once per 90 s game by default: every send has a fixed cost of a
 few tenths of a millisecond per entity; ``live_flush_every`` when a viewer is spawned).
-Any other error while recording (a bad value to log) disables the recorder with one
+Where a recording's instructions go (callgrind, seed 0's 90 s S-S game on enclosed, rerun-sdk
+0.41): half in rerun-sdk encoding the columns into the .rrd when the game ends (LZ4
+compression alone 29%), a quarter in building the columns at the send (the visibility
+outlines' rays 9%), a fifth in buffering the ticks; the particles are about 40% of the
+bytes. Any other error while recording (a bad value to log) disables the recorder with one
 warning and leaves no file; the game goes on.
 """
 
