@@ -4,7 +4,6 @@ or misled, and what pegame promises for it instead (README, "Exit codes")."""
 
 from __future__ import annotations
 
-import errno
 import os
 import subprocess
 import sys
@@ -132,14 +131,15 @@ def test_a_full_disk_fails_the_game_it_cannot_record_and_leaves_no_broken_record
 
 
 def test_a_recording_that_cannot_be_written_fails_its_game(tmp_path, monkeypatch, caplog):
-    real_fsync = os.fsync
+    real_open = os.open
 
-    def full_for_recordings(fd: int) -> None:
-        if os.readlink(f"/proc/self/fd/{fd}").endswith(".rrd.partial"):
-            raise OSError(errno.ENOSPC, "No space left on device")
-        real_fsync(fd)
+    def full_for_recordings(path: str, flags: int, *args: int) -> int:
+        # a recording's partial file opens /dev/full: its write fails with ENOSPC
+        if str(path).endswith(".rrd.partial"):
+            return real_open("/dev/full", os.O_WRONLY)
+        return real_open(path, flags, *args)
 
-    monkeypatch.setattr(files.os, "fsync", full_for_recordings)
+    monkeypatch.setattr(files.os, "open", full_for_recordings)
     cfg = compose(["recorder=rerun", "env=hall", "game.t_max=2", "game.trials=2", *RANDOM])
     run_ = job.run_job(cfg, tmp_path)
     assert run_.failed == [0, 1] and run_.status == 1
