@@ -79,20 +79,21 @@ def time_lost(root: Path) -> dict[tuple, dict[str, float]]:
     return {k: {c: v[c] / v["games"] if c != "games" else v[c] for c in v} for k, v in sums.items()}
 
 
-def mechanism(grid: dict, three_d: dict) -> dict[str, str]:
-    """The README's figures on why the sides differ, over the smart pursuer's cells on both
-    sides: the share of time in view, the time lost to misses per game and the mean length
-    of a loss sideways (``bearing``)."""
-    keys = [k for k in grid if k in three_d and k[2] != "R-R"]
-    out = {}
-    for side, table in (("grid", grid), ("3d", three_d)):
+def mechanism(sides: dict[str, dict]) -> dict[str, str]:
+    """The README's figures on why the sides (a name and its :func:`time_lost`) differ, over
+    the smart pursuer's cells all sides played: the share of time in view, the time lost to
+    misses and while turning per game, the losses sideways (``bearing``) per game and
+    their mean length."""
+    keys = [k for k in set.intersection(*(set(t) for t in sides.values())) if k[2] != "R-R"]
+    out = {"mechanism_cells": str(len(keys))}
+    for side, table in sides.items():
         cells = [table[k] for k in keys]
         out[f"visible_{side}"] = f"{100 * sum(c['visible'] for c in cells) / len(cells):.1f}%"
-        out[f"missed_s_{side}"] = f"{sum(c['missed'] for c in cells) / len(cells):.1f} s"
+        for cause in ("missed", "turning"):
+            out[f"{cause}_s_{side}"] = f"{sum(c[cause] for c in cells) / len(cells):.1f} s"
         per_loss = sum(c["bearing"] for c in cells) / sum(c["bearing_n"] for c in cells)
         out[f"bearing_loss_s_{side}"] = f"{per_loss:.1f} s"
         out[f"bearing_n_{side}"] = f"{sum(c['bearing_n'] for c in cells) / len(cells):.1f}"
-    out["mechanism_cells"] = str(len(keys))
     return out
 
 
@@ -174,7 +175,8 @@ def main(argv: list[str]) -> int:
         values[f"paper_inside_{name}"] = f"{inside} of {n}"
     write_atomic(HERE / "vs_paper.md", "\n".join(lines) + "\n")
     grid_losses, three_d_losses = time_lost(out / "grid"), time_lost(out / "3d")
-    values.update(mechanism(grid_losses, three_d_losses))
+    sides = {"grid": grid_losses, "plain": time_lost(out / "grid_plain"), "3d": three_d_losses}
+    values.update(mechanism(sides))
     text, csv_text = losses(grid_losses, three_d_losses)
     write_atomic(HERE / "losses.md", text)
     write_atomic(HERE / "losses.csv", csv_text)
