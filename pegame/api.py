@@ -71,6 +71,7 @@ __all__ = [
     "Recorder",
     "Region",
     "SensorFrame",
+    "OneOnOneSimulator",
     "Simulator",
     "Strategy",
     "TeamTick",
@@ -252,84 +253,112 @@ class Plugin(ABC):  # noqa: B024 - an abstract base for the interfaces, which ad
 
 
 class Simulator(Plugin):
-    """Holds the true state of both agents and renders the pursuer's sensor.
+    """Holds the true state of N pursuers and M evaders and renders each pursuer's sensor
+    (a 1v1 game is N = M = 1). Poses are in the map frame (m, m, rad); commands and poses
+    go in member order.
 
-    Teams: a simulator that can hold N pursuers and M evaders sets ``teams = True`` and
-    overrides the ``*_team`` methods; the defaults below play the 1v1 methods, for one
-    pursuer and one evader (the tick loop calls only the team methods).
+    A simulator that plays one pursuer against one evader only subclasses
+    :class:`OneOnOneSimulator` and writes its scalar methods instead.
     """
 
-    #: whether the ``*_team`` methods hold more than one pursuer or evader
-    teams: ClassVar[bool] = False
-
-    def reset_team(self, pursuers: Sequence[Pose], evaders: Sequence[Pose]) -> None:
-        """Place N pursuers and M evaders (map frame); the default plays :meth:`reset`."""
-        if len(pursuers) != 1 or len(evaders) != 1:
-            raise NotImplementedError(f"{type(self).__name__} plays one pursuer and one evader.")
-        self.reset(pursuers[0], evaders[0])
-
-    def step_team(
-        self, pursuer_cmds: Sequence[Velocity], evader_cmds: Sequence[Velocity], dt: float
-    ) -> None:
-        """:meth:`step` for every agent (commands in member order)."""
-        self.step(pursuer_cmds[0], evader_cmds[0], dt)
-
-    def step_team_one(self, role: str, cmds: Sequence[Velocity], dt: float) -> None:
-        """:meth:`step_one` for every agent of ``role``, the other role paused."""
-        self.step_one(role, cmds[0], dt)
-
-    @property
-    def team_poses(self) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
-        """The true poses of the (pursuers, evaders), in member order."""
-        pursuer, evader = self.poses
-        return (pursuer,), (evader,)
-
-    def sense_team(self, time: float) -> tuple[SensorFrame, ...]:
-        """Each pursuer camera's frame at ``time`` (s), in member order."""
-        return (self.sense(time),)
+    #: whether the simulator holds more than one pursuer or evader
+    teams: ClassVar[bool] = True
 
     @abstractmethod
-    def reset(self, pursuer: Pose, evader: Pose) -> None:
-        """Place both agents at the given map-frame poses.
+    def reset(self, pursuers: Sequence[Pose], evaders: Sequence[Pose]) -> None:
+        """Place the N pursuers and M evaders at the given map-frame poses.
 
-        :param pursuer: the pursuer's pose (m, m, rad), in the map frame.
-        :param evader: the evader's pose (m, m, rad), in the map frame.
+        :param pursuers: each pursuer's pose (m, m, rad), in member order.
+        :param evaders: each evader's pose (m, m, rad), in member order.
         """
 
     @abstractmethod
-    def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
-        """Advance dt seconds with both commands held; commands beyond an agent's limits
+    def step(
+        self, pursuer_cmds: Sequence[Velocity], evader_cmds: Sequence[Velocity], dt: float
+    ) -> None:
+        """Advance dt seconds with every command held; commands beyond an agent's limits
         are saturated (speed, turn rate and, when finite, the bodies' ``a_max`` and
         ``alpha_max``), and an agent never enters an obstacle (it stops at the wall).
 
-        :param pursuer_cmd: the pursuer's (v m/s, w rad/s), held for ``dt``.
-        :param evader_cmd: the evader's (v m/s, w rad/s), held for ``dt``.
+        :param pursuer_cmds: each pursuer's (v m/s, w rad/s), held for ``dt``.
+        :param evader_cmds: each evader's (v m/s, w rad/s), held for ``dt``.
         :param dt: the period (s), ``context.control_dt`` divided by the physics substeps.
         """
 
-    def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
-        """Advance only ``role`` ('pursuer' or 'evader') dt seconds with ``cmd`` held, the
-        other agent paused (its pose and velocity kept): the turns of
+    def step_one(self, role: str, cmds: Sequence[Velocity], dt: float) -> None:
+        """Advance only the agents of ``role`` ('pursuer' or 'evader') dt seconds with
+        ``cmds`` held, the other role paused (poses and velocities kept): the turns of
         ``game.turn_order=evader_first``. Optional: the tick loop refuses that turn order
         for a simulator that keeps this default."""
-        raise NotImplementedError(f"{type(self).__name__} cannot move one agent at a time.")
+        raise NotImplementedError(f"{type(self).__name__} cannot move one role at a time.")
 
     @property
     @abstractmethod
-    def poses(self) -> tuple[Pose, Pose]:
-        """The true (pursuer, evader) poses in the map frame."""
+    def poses(self) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
+        """The true (pursuers, evaders) poses in the map frame, in member order."""
 
     @abstractmethod
-    def sense(self, time: float) -> SensorFrame:
-        """The pursuer camera's frame at simulation time ``time`` (s).
+    def sense(self, time: float) -> tuple[SensorFrame, ...]:
+        """Each pursuer camera's frame at simulation time ``time`` (s), in member order.
 
-        :param time: the simulated time of the frame (s), the tick's.
-        :returns: the camera's pose and whatever the simulator renders (ground-truth
-            evader pose for the oracle; RGB, depth and segmentation for a 3D simulator).
+        :param time: the simulated time of the frames (s), the tick's.
+        :returns: per pursuer, the camera's pose and whatever the simulator renders
+            (ground-truth evader poses for the oracle; RGB, depth and segmentation for a
+            3D simulator).
         """
 
     def close(self) -> None:
         """Release resources (connections, windows). Called once per game."""
+
+
+class OneOnOneSimulator(Simulator):
+    """The small adapter for a simulator of one pursuer against one evader: write the
+    scalar methods below (``*_1v1``); the team-shaped :class:`Simulator` methods call them
+    with the one member of each role (and refuse more)."""
+
+    teams: ClassVar[bool] = False
+
+    @abstractmethod
+    def reset_1v1(self, pursuer: Pose, evader: Pose) -> None:
+        """Place both agents at the given map-frame poses (m, m, rad)."""
+
+    @abstractmethod
+    def step_1v1(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
+        """:meth:`Simulator.step` for the pursuer's and the evader's command."""
+
+    def step_one_1v1(self, role: str, cmd: Velocity, dt: float) -> None:
+        """:meth:`Simulator.step_one` for the one agent of ``role``. Optional."""
+        raise NotImplementedError(f"{type(self).__name__} cannot move one agent at a time.")
+
+    @property
+    @abstractmethod
+    def poses_1v1(self) -> tuple[Pose, Pose]:
+        """The true (pursuer, evader) poses in the map frame."""
+
+    @abstractmethod
+    def sense_1v1(self, time: float) -> SensorFrame:
+        """The pursuer camera's frame at simulation time ``time`` (s)."""
+
+    def reset(self, pursuers: Sequence[Pose], evaders: Sequence[Pose]) -> None:
+        if len(pursuers) != 1 or len(evaders) != 1:
+            raise NotImplementedError(f"{type(self).__name__} plays one pursuer and one evader.")
+        self.reset_1v1(pursuers[0], evaders[0])
+
+    def step(
+        self, pursuer_cmds: Sequence[Velocity], evader_cmds: Sequence[Velocity], dt: float
+    ) -> None:
+        self.step_1v1(pursuer_cmds[0], evader_cmds[0], dt)
+
+    def step_one(self, role: str, cmds: Sequence[Velocity], dt: float) -> None:
+        self.step_one_1v1(role, cmds[0], dt)
+
+    @property
+    def poses(self) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
+        pursuer, evader = self.poses_1v1
+        return (pursuer,), (evader,)
+
+    def sense(self, time: float) -> tuple[SensorFrame, ...]:
+        return (self.sense_1v1(time),)
 
 
 class Detector(Plugin):

@@ -105,11 +105,11 @@ def bench_sim_steps(grid: OccupancyGrid, steps: int) -> float:
     context = Context(grid, Body(0.2, 0.5, 1.8), Body(0.25, 0.5, 1.8), Camera(), 0.1, 1.0)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
     p, e = free_poses(grid, 0.25, 2, seed=2)
-    sim.reset(p, e)
-    cmd = Velocity(0.4, 0.3)
+    sim.reset((p,), (e,))
+    cmds = (Velocity(0.4, 0.3),)
     start = time.perf_counter()
     for _ in range(steps):
-        sim.step(cmd, cmd, 0.1)
+        sim.step(cmds, cmds, 0.1)
     return steps / (time.perf_counter() - start)
 
 

@@ -48,9 +48,9 @@ estimator and the region can be skipped (``estimate=False``: they are the most e
 part of a tick); the belief is then empty and the game has no estimation error.
 
 :class:`pegame.game.Game` (the CLI and sweeps) and the Gymnasium/PettingZoo environments
-(:mod:`pegame.envs`) both drive this loop. A 1v1 game moving together (two strategies, or
-an environment's learners) plays the same tick in a form without the team's per-member
-lists (:meth:`TickLoop._advance_1v1`).
+(:mod:`pegame.envs`) both drive this loop; a 1v1 game plays the same :meth:`TickLoop.advance`
+as a team's, with one member per role (the plugins' interfaces are team-shaped,
+:mod:`pegame.api`).
 """
 
 from __future__ import annotations
@@ -65,6 +65,7 @@ from pegame.api import (
     Estimator,
     Evader,
     EvaderObservation,
+    OneOnOneSimulator,
     Pursuer,
     PursuerObservation,
     PursuerTeam,
@@ -79,7 +80,6 @@ from pegame.losses import LossCauses
 from pegame.metrics import TeamMetrics, TrackingMetrics
 from pegame.types import (
     EMPTY_BELIEF,
-    STOP,
     Belief,
     Detection,
     Plan,
@@ -182,9 +182,9 @@ class TickLoop:
                 "the pursuer commands after seeing the evader's move, inside one tick. Use "
                 "game.turn_order=simultaneous with the environments."
             )
-        if turn_order == "evader_first" and type(plugins.sim).step_one is Simulator.step_one:
+        if turn_order == "evader_first" and not moves_one_role(type(plugins.sim)):
             raise ConfigError(
-                f"game.turn_order=evader_first needs a simulator that moves one agent at a "
+                f"game.turn_order=evader_first needs a simulator that moves one role at a "
                 f"time (Simulator.step_one); {type(plugins.sim).__name__} does not. Use "
                 "game.turn_order=simultaneous, or the grid simulator (sim=grid)."
             )
@@ -220,10 +220,6 @@ class TickLoop:
         self.evader_first = turn_order == "evader_first"
         self.pursuer_plans = [Plan()] * self.n_pursuers
         self.evader_plans = [Plan()] * self.n_evaders
-        # The most played game, one pursuer against one evader moving together (a game of
-        # two strategies, or an environment's), takes the fast form of a tick
-        # (:meth:`_advance_1v1`).
-        self.one_on_one = self.solo and not self.evader_first
 
     @property
     def done(self) -> bool:
@@ -283,7 +279,7 @@ class TickLoop:
                 f"start needs {self.n_pursuers} pursuer and {self.n_evaders} evader poses, "
                 f"got {len(pursuers)} and {len(evaders)}."
             )
-        self.sim.reset_team(pursuers, evaders)
+        self.sim.reset(pursuers, evaders)
         for row in self.detectors:
             for detector in row:
                 detector.reset()
@@ -301,49 +297,37 @@ class TickLoop:
     def _sense(self, regions: tuple[VisibilityRegion, ...] | None = None) -> None:
         """The current tick's poses, frames, detections, regions, beliefs and in_view;
         ``regions``: the pursuers' regions already built for their current poses, if any."""
-        if self.solo:
-            self._sense_one(regions)
-            return
         grid, camera, radius = self.context.grid, self.context.camera, self.context.evader.radius
-        self.pursuers, self.evaders = self.sim.team_poses
-        self.frames: tuple[SensorFrame, ...] = self.sim.sense_team(self.time)
-        self.detections = tuple(
-            tuple(_identified(detector.detect(frame.about(j)), j) for j, detector in enumerate(row))
-            for frame, row in zip(self.frames, self.detectors)
-        )
+        self.pursuers, self.evaders = self.sim.poses
+        self.frames: tuple[SensorFrame, ...] = self.sim.sense(self.time)
+        detections = []
+        for frame, row in zip(self.frames, self.detectors):  # loops, not comprehensions: per tick
+            if self.n_evaders == 1:  # one evader: nobody to tell apart
+                detections.append((row[0].detect(frame),))
+                continue
+            seen = []
+            for j, detector in enumerate(row):
+                seen.append(_identified(detector.detect(frame.about(j)), j))
+            detections.append(tuple(seen))
+        self.detections = tuple(detections)
         self.regions = (None,) * self.n_pursuers
         self.union = None
         self.beliefs: tuple[Belief, ...] = (EMPTY_BELIEF,) * self.n_evaders
         if self.estimate:
-            built = regions or tuple(VisibilityRegion(grid, pose, camera) for pose in self.pursuers)
+            built = regions or tuple(
+                [VisibilityRegion(grid, pose, camera) for pose in self.pursuers]
+            )
             union = built[0] if self.n_pursuers == 1 else UnionRegion(built)
             self.regions, self.union = built, union
-            self.beliefs = tuple(self._estimate(j, built[0], union) for j in range(self.n_evaders))
-        self.in_views = tuple(
-            tuple(body_in_view(grid, camera, p, (e.x, e.y), radius) for e in self.evaders)
-            for p in self.pursuers
-        )
-
-    def _sense_one(self, regions: tuple[VisibilityRegion, ...] | None) -> None:
-        """:meth:`_sense` of a 1v1 game through the simulator's and estimator's 1v1
-        methods: the same tick, without the team's per-member loops (a 1v1 game's ticks
-        are the most played; this keeps them as fast as before teams)."""
-        grid, camera = self.context.grid, self.context.camera
-        pursuer, evader = self.sim.poses
-        frame = self.sim.sense(self.time)
-        detection = self.detectors[0][0].detect(frame)
-        region, belief = None, EMPTY_BELIEF
-        if self.estimate:
-            region = regions[0] if regions else VisibilityRegion(grid, pursuer, camera)
-            estimator = self.estimators[0]
-            if self.step == 0:
-                belief = estimator.reset(pursuer, detection, region)
-            else:
-                belief = estimator.update(self.context.control_dt, pursuer, detection, region)
-        seen = body_in_view(grid, camera, pursuer, (evader.x, evader.y), self.context.evader.radius)
-        self.pursuers, self.evaders, self.frames = (pursuer,), (evader,), (frame,)
-        self.detections, self.regions, self.union = ((detection,),), (region,), region
-        self.beliefs, self.in_views = (belief,), ((seen,),)
+            self.beliefs = tuple(
+                [self._estimate(j, built[0], union) for j in range(self.n_evaders)]
+            )
+        in_views = []
+        for p in self.pursuers:
+            in_views.append(
+                tuple([body_in_view(grid, camera, p, (e.x, e.y), radius) for e in self.evaders])
+            )
+        self.in_views = tuple(in_views)
 
     def _estimate(self, j: int, region: Region, union: Region) -> Belief:
         """Evader j's estimator, reset at tick 0 and updated after, by every pursuer;
@@ -385,8 +369,6 @@ class TickLoop:
         tick. Returns the tick that was played."""
         if self.step >= self.ticks:
             raise RuntimeError("The game is over: every tick has been played.")
-        if self.one_on_one:
-            return self._advance_1v1(commands)
         commanded = self._commanded(commands) if commands or self.external else {}
         deciding = self.step % self.decide_every == 0
         evaders, pursuers = self.evader_strategies, self.pursuer_strategies
@@ -394,7 +376,7 @@ class TickLoop:
             # The evaders' turn, on the world after the pursuers' last move: their own
             # poses, the pursuers', and the pursuers' regions (kept for the sensing that
             # follows, since the pursuers do not move in the evaders' turn).
-            self.pursuers, self.evaders = self.sim.team_poses
+            self.pursuers, self.evaders = self.sim.poses
             grid, camera = self.context.grid, self.context.camera
             regions = tuple(VisibilityRegion(grid, pose, camera) for pose in self.pursuers)
             self.regions = regions
@@ -477,80 +459,6 @@ class TickLoop:
             self._sense()  # also after the last tick: the environments observe the final state
         return tick
 
-    def _advance_1v1(self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None) -> Tick:
-        """:meth:`advance` for one pursuer against one evader moving together: the same
-        tick in the same order, without the per-member lists and comprehensions of a
-        team's tick, which cost about 3% of a whole 1v1 game of two strategies (README,
-        Performance; the most played ticks: Game.play, sweeps and the environments).
-        ``tests/test_loop.py`` plays built-in pairings, and external roles, both ways and
-        requires the same ticks; set ``one_on_one`` False to take the general form."""
-        time, pursuer, evader = self.time, self.pursuers[0], self.evaders[0]
-        detection, belief, region = self.detections[0][0], self.beliefs[0], self.regions[0]
-        pursuer_strategy, evader_strategy = self.pursuer_strategies[0], self.evader_strategies[0]
-        e_obs = p_obs = None
-        if "evader" not in self.external:
-            e_obs = EvaderObservation(time, evader, pursuer, region, self.pursuers, 0)
-        if "pursuer" not in self.external:
-            assert region is not None  # a strategy pursuer turns the estimate on (__init__)
-            p_obs = PursuerObservation(time, pursuer, detection, belief, region, None)
-        if self.step % self.decide_every == 0:  # the evader first, then the pursuer (paper)
-            if e_obs is not None:
-                self.evader_plans = [evader_strategy.decide(e_obs)]
-            if p_obs is not None:
-                self.pursuer_plans = [pursuer_strategy.decide(p_obs)]
-        if self.external:
-            p_cmd, e_cmd = self._external_1v1(commands)
-        if p_obs is not None:
-            p_cmd = pursuer_strategy.control(p_obs)
-        if e_obs is not None:
-            e_cmd = evader_strategy.control(e_obs)
-        in_view, detected = self.in_views[0][0], detection is not None
-        self.tracking.add(pursuer, evader, detected, in_view, belief)
-        losses = self.losses.add_one(pursuer, evader, detected, p_cmd)
-        tick = Tick(
-            self.step,
-            time,
-            pursuer,
-            evader,
-            self.frames[0],
-            detection,
-            belief,
-            region,
-            in_view,
-            (p_cmd, e_cmd),
-            (self.pursuer_plans[0], self.evader_plans[0]),
-            None,
-            losses,
-        )
-        self.recorder.log(tick)
-        dt = self.context.control_dt / self.substeps
-        for _ in range(self.substeps):
-            self.sim.step(p_cmd, e_cmd, dt)
-        self._next_tick()
-        self._sense_one(None)
-        return tick
-
-    def _external_1v1(
-        self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None
-    ) -> tuple[Velocity, Velocity]:
-        """The (pursuer, evader) commands of the external roles of a 1v1 game (STOP for a
-        role its strategy commands), as :meth:`_commanded` reads them."""
-        commands = commands or {}
-        pursuer, evader = commands.get("pursuer"), commands.get("evader")
-        if ("pursuer" in self.external and pursuer is None) or (
-            "evader" in self.external and evader is None
-        ):
-            self._commanded(commands)  # raises, naming the missing roles
-        if pursuer is None:
-            pursuer = STOP
-        elif not isinstance(pursuer, Velocity):
-            pursuer = pursuer[0]
-        if evader is None:
-            evader = STOP
-        elif not isinstance(evader, Velocity):
-            evader = evader[0]
-        return pursuer, evader
-
     def _next_tick(self) -> None:
         self.step += 1
         self.time = self.step * self.context.control_dt
@@ -577,19 +485,12 @@ class TickLoop:
         dt = self.context.control_dt / self.substeps
         sim = self.sim
         for _ in range(self.substeps):
-            if self.solo:  # the simulator's 1v1 methods, as before teams
-                if pursuers is not None and evaders is not None:
-                    sim.step(pursuers[0], evaders[0], dt)
-                elif pursuers is not None:
-                    sim.step_one("pursuer", pursuers[0], dt)
-                elif evaders is not None:
-                    sim.step_one("evader", evaders[0], dt)
-            elif pursuers is not None and evaders is not None:
-                sim.step_team(pursuers, evaders, dt)
+            if pursuers is not None and evaders is not None:
+                sim.step(pursuers, evaders, dt)
             elif pursuers is not None:
-                sim.step_team_one("pursuer", pursuers, dt)
+                sim.step_one("pursuer", pursuers, dt)
             elif evaders is not None:
-                sim.step_team_one("evader", evaders, dt)
+                sim.step_one("evader", evaders, dt)
 
 
 def _built(regions: tuple[VisibilityRegion | None, ...]) -> TypeGuard[tuple[VisibilityRegion, ...]]:
@@ -602,6 +503,14 @@ def _identified(detection: Detection | None, evader: int) -> Detection | None:
     if detection is None or detection.evader == evader:
         return detection
     return replace(detection, evader=evader)
+
+
+def moves_one_role(sim: type[Simulator]) -> bool:
+    """Whether the simulator class can move one role with the other paused
+    (:meth:`Simulator.step_one`, or :meth:`OneOnOneSimulator.step_one_1v1`)."""
+    if issubclass(sim, OneOnOneSimulator):
+        return sim.step_one_1v1 is not OneOnOneSimulator.step_one_1v1
+    return sim.step_one is not Simulator.step_one
 
 
 def check_team(sim: type[Simulator], detector: type[Detector], pursuers: int, evaders: int) -> None:

@@ -1,4 +1,4 @@
-"""The tick loop's fast 1v1 form plays the same ticks as its general form."""
+"""The tick loop: one advance for a 1v1 game and a team's; external roles' commands."""
 
 from __future__ import annotations
 
@@ -9,21 +9,10 @@ from pegame.config import compose
 from pegame.game import Game
 from pegame.types import Velocity
 
-PAIRINGS = [
-    ("smart", "smart", "enclosed"),
-    ("anticipating", "elusive", "hall"),
-    ("random", "random", "brick"),
-    ("smart", "random", "brick"),
-    ("anticipating", "smart", "enclosed"),
-]
 
-
-def _ticks(pursuer: str, evader: str, env: str, one_on_one: bool, extra=()) -> list:
-    overrides = [f"pursuer={pursuer}", f"evader={evader}", f"env={env}", "recorder=none"]
-    game = Game(compose([*overrides, "game.t_max=12", "game.seed=4", *extra]))
+def _ticks(overrides: list[str]) -> list:
+    game = Game(compose(["recorder=none", "game.t_max=12", "game.seed=4", *overrides]))
     loop = game.start()
-    assert loop.one_on_one  # a 1v1 game of strategies moving together takes the fast form
-    loop.one_on_one = one_on_one
     ticks = []
     while not loop.done:
         tick = loop.advance()
@@ -31,7 +20,6 @@ def _ticks(pursuer: str, evader: str, env: str, one_on_one: bool, extra=()) -> l
         ticks.append(
             (
                 tick.step,
-                tick.time,
                 tick.pursuer,
                 tick.evader,
                 tick.detection,
@@ -42,62 +30,38 @@ def _ticks(pursuer: str, evader: str, env: str, one_on_one: bool, extra=()) -> l
                 tuple(plan.goal for plan in tick.plans),
             )
         )
-    return ticks, loop.metrics.summary(), (loop.substeps, loop.decide_every)
+    return ticks, loop.metrics.summary()
 
 
-@pytest.mark.parametrize(("pursuer", "evader", "env"), PAIRINGS)
-def test_the_fast_1v1_tick_plays_the_general_tick(pursuer, evader, env):
-    fast, fast_summary, _ = _ticks(pursuer, evader, env, one_on_one=True)
-    general, general_summary, _ = _ticks(pursuer, evader, env, one_on_one=False)
-    assert len(fast) == len(general) == 120
-    assert fast == general
-    assert fast_summary == general_summary
-
-
-def test_the_fast_1v1_tick_plays_the_general_tick_over_substeps_and_slow_decisions():
-    extra = ("game.physics_hz=40", "game.decision_hz=0.5")
-    fast, _, timing = _ticks("smart", "smart", "hall", one_on_one=True, extra=extra)
-    general, _, _ = _ticks("smart", "smart", "hall", one_on_one=False, extra=extra)
-    assert timing == (4, 20)  # 4 simulator steps per tick, a decision every 20 ticks
-    assert fast == general
+@pytest.mark.parametrize("team", ["team.pursuers=1", "team.evaders=1"])
+def test_a_team_of_one_against_one_is_the_1v1_game(team):
+    # one advance: a team config of one pursuer and one evader plays the 1v1 game's ticks
+    one = _ticks(["pursuer=smart", "evader=smart", "env=enclosed"])
+    assert one == _ticks(["pursuer=smart", "evader=smart", "env=enclosed", team])
+    assert len(one[0]) == 120
 
 
 @pytest.mark.parametrize("external", [("pursuer",), ("evader",), ("pursuer", "evader")])
-def test_the_fast_1v1_tick_plays_external_roles_as_the_general_tick(external):
-    def play(one_on_one: bool) -> list:
-        game = Game(compose(["recorder=none", "game.t_max=6", "game.seed=2", "env=hall"]))
-        loop = game.start(external=external)
-        assert loop.one_on_one
-        loop.one_on_one = one_on_one
-        rng = np.random.default_rng(0)
-        ticks = []
-        while not loop.done:
-            commands = {
-                role: Velocity(float(rng.uniform(0.0, 0.5)), float(rng.uniform(-1.0, 1.0)))
-                for role in external
-            }
-            tick = loop.advance(commands)
-            ticks.append((tick.pursuer, tick.evader, tick.detection, tick.commands, tick.in_view))
-        return ticks
-
-    fast = play(True)
-    assert fast == play(False)
-    assert len(fast) == 60
+def test_external_roles_move_by_the_commands_given(external):
+    game = Game(compose(["recorder=none", "game.t_max=6", "game.seed=2", "env=hall"]))
+    loop = game.start(external=external)
+    rng = np.random.default_rng(0)
+    for _ in range(60):
+        commands = {
+            role: Velocity(float(rng.uniform(0.0, 0.5)), float(rng.uniform(-1.0, 1.0)))
+            for role in external
+        }
+        tick = loop.advance(commands)
+        for k, role in enumerate(("pursuer", "evader")):
+            if role in external:
+                assert tick.commands[k] == commands[role]
+    assert loop.done
 
 
-def test_a_missing_external_command_is_refused_by_both_forms():
-    for one_on_one in (True, False):
-        loop = Game(compose(["recorder=none", "game.t_max=2"])).start(external=("evader",))
-        loop.one_on_one = one_on_one
-        with pytest.raises(ValueError, match="No command for the external role"):
-            loop.advance({"pursuer": Velocity(0.1, 0.0)})
-
-
-def test_turns_and_teams_take_the_general_tick():
-    turns = Game(compose(["recorder=none", "game.t_max=2", "game.turn_order=evader_first"]))
-    assert not turns.start().one_on_one
-    team = Game(compose(["recorder=none", "game.t_max=2", "team.pursuers=2"]))
-    assert not team.start().one_on_one
+def test_a_missing_external_command_is_refused():
+    loop = Game(compose(["recorder=none", "game.t_max=2"])).start(external=("evader",))
+    with pytest.raises(ValueError, match="No command for the external role"):
+        loop.advance({"pursuer": Velocity(0.1, 0.0)})
 
 
 def test_a_pursuer_observation_without_the_regions_is_refused():

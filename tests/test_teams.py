@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from pegame.api import Detection, Detector, Simulator, fuse_detections
+from pegame.api import Detection, Detector, OneOnOneSimulator, Simulator, fuse_detections
 from pegame.config import compose
 from pegame.detectors.oracle import OracleDetector
 from pegame.errors import ConfigError, SpawnError, require
@@ -171,7 +171,7 @@ def test_a_simulator_without_teams_or_a_detector_that_cannot_tell_evaders_apart_
     with pytest.raises(ConfigError, match="cannot tell evaders apart"):
         check_team(GridSimulator, _Blind, 1, 2)
     check_team(GridSimulator, _Blind, 3, 1)  # one evader: no identity needed
-    assert Simulator.teams is False and OracleDetector.identifies
+    assert Simulator.teams and not OneOnOneSimulator.teams and OracleDetector.identifies
 
 
 # -------------------------------------------------------------------------------- spawn

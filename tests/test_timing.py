@@ -115,14 +115,14 @@ def test_substeps_never_enter_walls(seed, substeps, control_dt):
     pursuer, evader = Body(0.2, 0.8, 3.0), Body(0.25, 0.8, 3.0)
     context = Context(grid, pursuer, evader, Camera(), control_dt, control_dt)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
-    sim.reset(Pose(*grid.cell_to_world(10, 10)), Pose(*grid.cell_to_world(50, 70)))
+    sim.reset((Pose(*grid.cell_to_world(10, 10)),), (Pose(*grid.cell_to_world(50, 70)),))
     masks = inflate(grid, pursuer.radius), inflate(grid, evader.radius)
     rng = np.random.default_rng(seed)
     for _ in range(30):
-        commands = [Velocity(*rng.uniform(-1.0, 1.0, 2) * [0.8, 3.0]) for _ in range(2)]
+        commands = [(Velocity(*rng.uniform(-1.0, 1.0, 2) * [0.8, 3.0]),) for _ in range(2)]
         for _ in range(substeps):
             sim.step(*commands, control_dt / substeps)
-            for pose, mask in zip(sim.poses, masks):
+            for (pose,), mask in zip(sim.poses, masks):
                 row, col = grid.world_to_cell(pose.x, pose.y)
                 assert grid.contains(row, col) and not mask[row, col]
 
@@ -165,11 +165,11 @@ def accelerating_sim(a_max=0.5, alpha_max=1.0):
 
 def test_a_straight_drive_from_rest_ramps_at_a_max():
     sim, dt = accelerating_sim(a_max=0.5), 0.1
-    sim.reset(Pose(0.5, 1.5, 0.0), Pose(3.5, 2.5))
-    x = [sim.poses[0].x]
+    sim.reset((Pose(0.5, 1.5, 0.0),), (Pose(3.5, 2.5),))
+    x = [sim.poses[0][0].x]
     for _ in range(20):
-        sim.step(Velocity(0.8, 0.0), Velocity(), dt)
-        x.append(sim.poses[0].x)
+        sim.step((Velocity(0.8, 0.0),), (Velocity(),), dt)
+        x.append(sim.poses[0][0].x)
     speeds = np.diff(x) / dt
     expected = np.minimum(0.5 * dt * np.arange(1, 21), 0.8)
     np.testing.assert_allclose(speeds, expected, atol=1e-9)
@@ -181,12 +181,12 @@ def test_speed_and_turn_rate_change_at_most_a_max_dt_per_step(seed, dt):
     a_max, alpha_max = 0.5, 1.0
     sim = accelerating_sim(a_max, alpha_max)
     grid = walled_room()
-    sim.reset(Pose(*grid.cell_to_world(10, 10)), Pose(*grid.cell_to_world(50, 70)))
+    sim.reset((Pose(*grid.cell_to_world(10, 10)),), (Pose(*grid.cell_to_world(50, 70)),))
     rng = np.random.default_rng(seed)
     agent = sim._pursuers[0]
     for _ in range(100):
         before = agent.velocity
-        sim.step(Velocity(*rng.uniform(-1.0, 1.0, 2) * [1.0, 4.0]), Velocity(), dt)
+        sim.step((Velocity(*rng.uniform(-1.0, 1.0, 2) * [1.0, 4.0]),), (Velocity(),), dt)
         after = agent.velocity
         assert abs(after.w - before.w) <= alpha_max * dt + 1e-12 and abs(after.w) <= 3.0
         # the speed ramps by at most a_max * dt, or drops to 0 where a wall stops the agent

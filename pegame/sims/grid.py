@@ -265,10 +265,7 @@ class GridSimulator(Simulator):
         self._pursuers = [_Agent(context.grid, context.pursuer)]
         self._evaders = [_Agent(context.grid, context.evader)]
 
-    def reset(self, pursuer: Pose, evader: Pose) -> None:
-        self.reset_team((pursuer,), (evader,))
-
-    def reset_team(self, pursuers: Sequence[Pose], evaders: Sequence[Pose]) -> None:
+    def reset(self, pursuers: Sequence[Pose], evaders: Sequence[Pose]) -> None:
         context = self.context
         for agents, poses, body in (
             (self._pursuers, pursuers, context.pursuer),
@@ -284,11 +281,7 @@ class GridSimulator(Simulator):
                     )
                 agent.pose, agent.velocity = pose, STOP
 
-    def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
-        self._pursuers[0].move(pursuer_cmd, dt)
-        self._evaders[0].move(evader_cmd, dt)
-
-    def step_team(
+    def step(
         self, pursuer_cmds: Sequence[Velocity], evader_cmds: Sequence[Velocity], dt: float
     ) -> None:
         for agent, cmd in zip(self._pursuers, pursuer_cmds):
@@ -296,33 +289,24 @@ class GridSimulator(Simulator):
         for agent, cmd in zip(self._evaders, evader_cmds):
             agent.move(cmd, dt)
 
-    def step_one(self, role: str, cmd: Velocity, dt: float) -> None:
-        (self._pursuers if role == "pursuer" else self._evaders)[0].move(cmd, dt)
-
-    def step_team_one(self, role: str, cmds: Sequence[Velocity], dt: float) -> None:
+    def step_one(self, role: str, cmds: Sequence[Velocity], dt: float) -> None:
         for agent, cmd in zip(self._pursuers if role == "pursuer" else self._evaders, cmds):
             agent.move(cmd, dt)
 
     @property
-    def poses(self) -> tuple[Pose, Pose]:
-        return self._pursuers[0].pose, self._evaders[0].pose
+    def poses(self) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
+        return tuple([a.pose for a in self._pursuers]), tuple([a.pose for a in self._evaders])
 
-    @property
-    def team_poses(self) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
-        return tuple(a.pose for a in self._pursuers), tuple(a.pose for a in self._evaders)
-
-    def sense(self, time: float) -> SensorFrame:
-        return SensorFrame(
-            time=time, camera_pose=self._pursuers[0].pose, evader_truth=self._evaders[0].pose
-        )
-
-    def sense_team(self, time: float) -> tuple[SensorFrame, ...]:
-        if len(self._pursuers) == 1 and len(self._evaders) == 1:
-            return (self.sense(time),)
-        evaders = tuple(a.pose for a in self._evaders)
+    def sense(self, time: float) -> tuple[SensorFrame, ...]:
+        if len(self._pursuers) == 1 and len(self._evaders) == 1:  # a 1v1 frame: no list
+            pose, evader = self._pursuers[0].pose, self._evaders[0].pose
+            return (SensorFrame(time=time, camera_pose=pose, evader_truth=evader),)
+        evaders = tuple([a.pose for a in self._evaders])
         return tuple(
-            SensorFrame(
-                time=time, camera_pose=a.pose, evader_truth=evaders[0], evaders_truth=evaders
-            )
-            for a in self._pursuers
+            [
+                SensorFrame(
+                    time=time, camera_pose=a.pose, evader_truth=evaders[0], evaders_truth=evaders
+                )
+                for a in self._pursuers
+            ]
         )

@@ -39,11 +39,11 @@ def test_saturate_clips_to_the_body_limits():
 def test_free_motion_is_the_exact_unicycle_arc():
     sim = simulator(walled_room())
     start = Pose(1.0, 1.0, 0.3)
-    sim.reset(start, Pose(3.5, 2.5))
+    sim.reset((start,), (Pose(3.5, 2.5),))
     for cmd in (Velocity(0.4, 0.0), Velocity(0.4, 1.0), Velocity(-0.2, -0.5)):
-        sim.step(cmd, Velocity(), DT)
+        sim.step((cmd,), (Velocity(),), DT)
         expected = unicycle(start, cmd, DT)
-        assert sim.poses[0] == expected
+        assert sim.poses[0][0] == expected
         start = expected
     # Closed form of the arc: centre at distance v / w to the left of the heading.
     v, w, theta = 0.4, 1.0, 0.3
@@ -56,13 +56,15 @@ def test_free_motion_is_the_exact_unicycle_arc():
 def test_an_agent_stops_at_a_wall_and_can_still_turn():
     grid = walled_room()
     sim = simulator(grid)
-    sim.reset(Pose(1.0, 1.5, 0.0), Pose(3.5, 2.5))  # heading at the pillar's left face x = 1.75
+    sim.reset(
+        (Pose(1.0, 1.5, 0.0),), (Pose(3.5, 2.5),)
+    )  # heading at the pillar's left face x = 1.75
     for _ in range(40):
-        sim.step(Velocity(0.5, 0.0), Velocity(), DT)
-    stopped = sim.poses[0]
+        sim.step((Velocity(0.5, 0.0),), (Velocity(),), DT)
+    stopped = sim.poses[0][0]
     assert 1.75 - PURSUER.radius - 0.05 <= stopped.x <= 1.75 - PURSUER.radius and stopped.y == 1.5
-    sim.step(Velocity(0.5, 1.0), Velocity(), DT)
-    assert sim.poses[0].theta == pytest.approx(0.1)
+    sim.step((Velocity(0.5, 1.0),), (Velocity(),), DT)
+    assert sim.poses[0][0].theta == pytest.approx(0.1)
 
 
 @pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-1.2, 0.7, 0.4)])
@@ -70,14 +72,14 @@ def test_random_commands_never_enter_inflated_cells(origin):
     grid = walled_room(origin)
     sim = simulator(grid)
     rng = np.random.default_rng(1)
-    sim.reset(Pose(*grid.cell_to_world(10, 10)), Pose(*grid.cell_to_world(50, 70)))
+    sim.reset((Pose(*grid.cell_to_world(10, 10)),), (Pose(*grid.cell_to_world(50, 70)),))
     masks = inflate(grid, PURSUER.radius), inflate(grid, EVADER.radius)
     moved = 0.0
     for _ in range(3000):
         before = sim.poses
-        commands = [Velocity(*rng.uniform(-1.0, 1.0, 2) * [0.8, 3.0]) for _ in range(2)]
+        commands = [(Velocity(*rng.uniform(-1.0, 1.0, 2) * [0.8, 3.0]),) for _ in range(2)]
         sim.step(*commands, DT)
-        for pose, old, mask in zip(sim.poses, before, masks):
+        for (pose,), (old,), mask in zip(sim.poses, before, masks):
             row, col = grid.world_to_cell(pose.x, pose.y)
             assert grid.contains(row, col) and not mask[row, col]
             moved += pose.distance_to(old)
@@ -137,21 +139,21 @@ def test_the_move_kernel_on_a_batch_of_one_is_the_plain_move(a_max, origin):
     context = Context(grid, body, EVADER, Camera(), DT, 1.0)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
     start = Pose(*grid.cell_to_world(10, 10), 0.3)
-    sim.reset(start, Pose(*grid.cell_to_world(50, 70)))
+    sim.reset((start,), (Pose(*grid.cell_to_world(50, 70)),))
     blocked = inflate(grid, body.radius)
     pose, velocity = start, Velocity(0.0, 0.0)
     rng = np.random.default_rng(4)
     for _ in range(400):  # long enough to run into walls
         cmd = Velocity(rng.uniform(-0.7, 0.7), rng.uniform(-2.5, 2.5))
         pose, velocity = _move_reference(grid, blocked, body, pose, velocity, cmd, DT)
-        sim.step(cmd, Velocity(), DT)
-        assert sim.poses[0] == pose
+        sim.step((cmd,), (Velocity(),), DT)
+        assert sim.poses[0][0] == pose
 
 
 def test_start_inside_an_obstacle_is_refused():
     sim = simulator(walled_room())
     with pytest.raises(ValueError, match="inside an obstacle"):
-        sim.reset(Pose(0.1, 1.0), Pose(3.5, 2.5))
+        sim.reset((Pose(0.1, 1.0),), (Pose(3.5, 2.5),))
 
 
 def test_infinite_acceleration_takes_the_command_exactly():
@@ -173,25 +175,25 @@ def test_a_wall_stops_the_forward_speed_and_keeps_the_turn_rate():
     body = Body(0.2, 0.5, 1.8, a_max=1.0, alpha_max=2.0)
     context = Context(walled_room(), body, EVADER, Camera(), DT, 1.0)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
-    sim.reset(Pose(1.0, 1.5, 0.0), Pose(3.5, 2.5))  # heading at the pillar's left face
+    sim.reset((Pose(1.0, 1.5, 0.0),), (Pose(3.5, 2.5),))  # heading at the pillar's left face
     for _ in range(40):
-        sim.step(Velocity(0.5, 0.0), Velocity(), DT)
+        sim.step((Velocity(0.5, 0.0),), (Velocity(),), DT)
     assert sim._pursuers[0].velocity == Velocity(0.0, 0.0)
-    at_wall = sim.poses[0]
-    sim.step(Velocity(0.5, 1.0), Velocity(), DT)  # still pressed against the wall, turning
+    at_wall = sim.poses[0][0]
+    sim.step((Velocity(0.5, 1.0),), (Velocity(),), DT)  # still pressed against the wall, turning
     assert sim._pursuers[0].velocity == Velocity(0.0, pytest.approx(0.2))
-    assert sim.poses[0].theta == pytest.approx(at_wall.theta + 0.2 * DT)
+    assert sim.poses[0][0].theta == pytest.approx(at_wall.theta + 0.2 * DT)
 
 
 def test_step_one_moves_one_agent_and_pauses_the_other():
     body = Body(0.2, 0.5, 1.8, a_max=1.0, alpha_max=2.0)
     context = Context(walled_room(), body, body, Camera(), DT, 1.0)
     sim = GridSimulator(GridSimulator.Config(), context, np.random.default_rng(0))
-    sim.reset(Pose(1.0, 1.0, 0.0), Pose(3.0, 2.5, 0.0))
-    sim.step(Velocity(0.5, 0.0), Velocity(0.5, 0.0), DT)
-    pursuer, evader, paused = *sim.poses, sim._evaders[0].velocity
-    sim.step_one("pursuer", Velocity(0.5, 0.0), DT)
-    assert sim.poses[1] == evader and sim._evaders[0].velocity == paused
-    assert sim.poses[0].x > pursuer.x
-    sim.step_one("evader", Velocity(0.5, 0.0), DT)
-    assert sim.poses[1].x == pytest.approx(evader.x + 0.2 * DT)  # resumed from its kept 0.1 m/s
+    sim.reset((Pose(1.0, 1.0, 0.0),), (Pose(3.0, 2.5, 0.0),))
+    sim.step((Velocity(0.5, 0.0),), (Velocity(0.5, 0.0),), DT)
+    ((pursuer,), (evader,)), paused = sim.poses, sim._evaders[0].velocity
+    sim.step_one("pursuer", (Velocity(0.5, 0.0),), DT)
+    assert sim.poses[1][0] == evader and sim._evaders[0].velocity == paused
+    assert sim.poses[0][0].x > pursuer.x
+    sim.step_one("evader", (Velocity(0.5, 0.0),), DT)
+    assert sim.poses[1][0].x == pytest.approx(evader.x + 0.2 * DT)  # resumed from its kept 0.1 m/s

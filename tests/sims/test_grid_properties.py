@@ -174,11 +174,11 @@ def test_moves_keep_to_the_limits_and_out_of_inflated_cells(
     row, col = free[data.draw(st.integers(0, len(free) - 1))]
     start = Pose(*point_on(grid, col + 0.5, row + 0.5), data.draw(st.floats(-4.0, 4.0)))
     sim = simulator(grid, body, dt)
-    sim.reset(start, start)
+    sim.reset((start,), (start,))
     for cmd in data.draw(st.lists(COMMANDS, min_size=1, max_size=30)):
-        before = sim.poses[0]
-        sim.step_one("pursuer", cmd, dt)
-        after = sim.poses[0]
+        before = sim.poses[0][0]
+        sim.step_one("pursuer", (cmd,), dt)
+        after = sim.poses[0][0]
         cell = grid.world_to_cell(after.x, after.y)
         assert grid.contains(*cell) and not blocked[cell]
         bound = arc_error_bound(before, saturate(cmd, body), dt)  # the arc's known error
@@ -197,10 +197,10 @@ def test_free_motion_is_the_unicycle_arc_of_the_saturated_command(
     grid = OccupancyGrid(np.zeros((60, 60), np.int8), 0.1)
     start = Pose(*pose)  # 2.5 m from the walls, beyond any move (at most 0.75 m)
     sim = simulator(grid, body, dt)
-    sim.reset(start, start)
-    sim.step_one("pursuer", cmd, dt)
+    sim.reset((start,), (start,))
+    sim.step_one("pursuer", (cmd,), dt)
     expected = unicycle(start, saturate(cmd, body), dt)
-    moved = sim.poses[0]
+    moved = sim.poses[0][0]
     assert moved.theta == expected.theta
     assert math.isclose(moved.x, expected.x, abs_tol=1e-12)
     assert math.isclose(moved.y, expected.y, abs_tol=1e-12)

@@ -135,7 +135,7 @@ def visibility_agreement(
                 for row in played.trajectory:
                     p, e = Pose(*row[2:5]), Pose(*row[5:8])
                     sim.place(p, e)
-                    pixels = detector.detect(sim.sense(row[1])) is not None
+                    pixels = detector.detect(sim.sense_1v1(row[1])) is not None
                     if pixels and min_visible > 0:
                         pixels = sim.evader_visible_fraction() >= min_visible
                     in_view = bool(row[9])
@@ -177,11 +177,11 @@ def memory_growth(cycles: int = 30, env: str = "enclosed", steps: int = 10) -> d
     def cycle(k: int) -> None:
         sim = cls(config, game.context, rng)
         pursuer, evader = spawn(game.context, np.random.default_rng(k))
-        sim.reset(pursuer, evader)
+        sim.reset_1v1(pursuer, evader)
         try:
             for step in range(steps):
-                sim.sense(step * game.context.control_dt)
-                sim.step(ARC, ARC, game.context.control_dt)
+                sim.sense_1v1(step * game.context.control_dt)
+                sim.step_1v1(ARC, ARC, game.context.control_dt)
         finally:
             sim.close()
 

@@ -20,7 +20,7 @@ into a wall's box at convex corners; with the inset every cell centre they consi
 other (as in the grid simulator).
 
 Camera. Rendered with TinyRenderer (:mod:`pegame_pybullet.camera`) at ``camera_hz``:
-:meth:`PybulletSimulator.sense` renders when a frame is due and otherwise returns the last
+:meth:`PybulletSimulator.sense_1v1` renders when a frame is due and otherwise returns the last
 frame again (same object, its own time and poses). The optical centre is on the pursuer's
 axis, so ``SensorFrame.camera_pose`` is the pursuer's pose as in the grid simulator; the
 pursuer's own body is moved out of the way while its camera renders, and the floor is
@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet
 
-from pegame.api import Context, Simulator
+from pegame.api import Context, OneOnOneSimulator
 from pegame.errors import ConfigError, require
 from pegame.sims.grid import saturate, unicycle
 from pegame.types import Body, Pose, SensorFrame, Velocity
@@ -142,7 +142,7 @@ class _Mover:
             self.walker.walk(free * (c * dx + s * dy))
 
 
-class PybulletSimulator(Simulator):
+class PybulletSimulator(OneOnOneSimulator):
     """Kinematic unicycles in a 3D PyBullet world; an RGB-D camera with segmentation."""
 
     description = "3D PyBullet world from the map: TurtleBot, human evader, rendered RGB-D camera."
@@ -242,7 +242,7 @@ class PybulletSimulator(Simulator):
 
     # ------------------------------------------------------------- Simulator
 
-    def reset(self, pursuer: Pose, evader: Pose) -> None:
+    def reset_1v1(self, pursuer: Pose, evader: Pose) -> None:
         for role, free in zip(("pursuer", "evader"), self.place(pursuer, evader)):
             if not free:
                 pose = pursuer if role == "pursuer" else evader
@@ -253,22 +253,22 @@ class PybulletSimulator(Simulator):
 
     def place(self, pursuer: Pose, evader: Pose) -> tuple[bool, bool]:
         """Put both agents at the given poses (connecting first if needed) and forget the
-        last frame; returns whether each pose is free of the walls. :meth:`reset` is this
+        last frame; returns whether each pose is free of the walls. :meth:`reset_1v1` is this
         plus the check; replaying another simulator's trajectory uses it directly."""
         if self._client is None or not self._client.connected:
             self._connect()
         self._frame = None
         return self._pursuer.reset(pursuer), self._evader.reset(evader)
 
-    def step(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
+    def step_1v1(self, pursuer_cmd: Velocity, evader_cmd: Velocity, dt: float) -> None:
         self._pursuer.move(pursuer_cmd, dt)
         self._evader.move(evader_cmd, dt)
 
     @property
-    def poses(self) -> tuple[Pose, Pose]:
+    def poses_1v1(self) -> tuple[Pose, Pose]:
         return self._pursuer.pose, self._evader.pose
 
-    def sense(self, time: float) -> SensorFrame:
+    def sense_1v1(self, time: float) -> SensorFrame:
         period = 1.0 / self.config.camera_hz
         if self._frame is None or time >= self._frame.time + period - 1e-9:
             pose = self._pursuer.pose

@@ -30,7 +30,7 @@ def shin_position(sim: PybulletSimulator) -> np.ndarray:
 def test_the_person_has_revolute_hips_knees_shoulders_and_elbows(context):
     sim = PybulletSimulator(PybulletSimulator.Config(), context, np.random.default_rng(0))
     try:
-        sim.reset(Pose(0.3, 1.0, 0.0), Pose(0.9, 1.0, 0.0))
+        sim.reset_1v1(Pose(0.3, 1.0, 0.0), Pose(0.9, 1.0, 0.0))
         body = sim.labels["evader"]
         assert sim.client.getNumJoints(body) == len(JOINTS) == 8
         for j in range(len(JOINTS)):
@@ -45,16 +45,16 @@ def test_the_person_has_revolute_hips_knees_shoulders_and_elbows(context):
 def test_the_joints_move_with_the_distance_walked_and_stop_with_the_body(context):
     sim = PybulletSimulator(PybulletSimulator.Config(), context, np.random.default_rng(0))
     try:
-        sim.reset(Pose(0.3, 1.0, 0.0), Pose(0.9, 1.0, 0.0))
+        sim.reset_1v1(Pose(0.3, 1.0, 0.0), Pose(0.9, 1.0, 0.0))
         still = Velocity(0.0, 0.0)
-        sim.step(still, Velocity(0.35, 0.0), 1.0)  # a quarter of a stride
-        assert sim.poses[1].x == pytest.approx(1.25)
+        sim.step_1v1(still, Velocity(0.35, 0.0), 1.0)  # a quarter of a stride
+        assert sim.poses_1v1[1].x == pytest.approx(1.25)
         assert joint_angles(sim) == pytest.approx(gait_angles(0.35))
         assert not np.allclose(joint_angles(sim), gait_angles(0.0))
         knee = shin_position(sim)
-        sim.step(still, Velocity(0.0, 0.5), 1.0)  # turning on the spot: no step taken
+        sim.step_1v1(still, Velocity(0.0, 0.5), 1.0)  # turning on the spot: no step taken
         assert joint_angles(sim) == pytest.approx(gait_angles(0.35))
-        sim.step(still, Velocity(-0.35, 0.0), 1.0)  # walking back undoes the stride
+        sim.step_1v1(still, Velocity(-0.35, 0.0), 1.0)  # walking back undoes the stride
         assert joint_angles(sim) == pytest.approx(gait_angles(0.0))
         assert not np.allclose(shin_position(sim), knee)
     finally:
@@ -73,8 +73,8 @@ def floor_rows(tilt: float, context) -> int:
     config = PybulletSimulator.Config(camera_tilt=tilt, width=160, height=120)
     sim = PybulletSimulator(config, context, np.random.default_rng(0))
     try:
-        sim.reset(Pose(0.6, 1.0, 0.0), Pose(0.3, 1.0, 0.0))  # evader behind the camera
-        frame = sim.sense(0.0)
+        sim.reset_1v1(Pose(0.6, 1.0, 0.0), Pose(0.3, 1.0, 0.0))  # evader behind the camera
+        frame = sim.sense_1v1(0.0)
         floor = np.any(frame.segmentation == sim.labels["floor"], axis=1)
         return int(np.argmax(floor))
     finally:

@@ -31,7 +31,7 @@ def make_sim(context, **options) -> PybulletSimulator:
 @pytest.fixture
 def sim(context):
     sim = make_sim(context)
-    sim.reset(Pose(0.5, 1.0, 0.0), Pose(3.5, 2.0, 0.0))
+    sim.reset_1v1(Pose(0.5, 1.0, 0.0), Pose(3.5, 2.0, 0.0))
     yield sim
     sim.close()
 
@@ -75,24 +75,24 @@ def test_walls_are_exactly_where_the_map_has_them(context, origin):
 
 def test_the_robot_cannot_pass_through_a_wall(sim, context):
     radius = context.pursuer.radius - 0.5 * context.grid.resolution  # the collision cylinder
-    sim.reset(Pose(1.0, 1.0, 0.0), Pose(3.5, 2.0, 0.0))
+    sim.reset_1v1(Pose(1.0, 1.0, 0.0), Pose(3.5, 2.0, 0.0))
     for _ in range(60):  # 1 m/s for 6 s: far past the wall if nothing stopped it
-        sim.step(Velocity(1.0, 0.0), Velocity(0.0, 0.0), 0.1)
-    pursuer, _ = sim.poses
+        sim.step_1v1(Velocity(1.0, 0.0), Velocity(0.0, 0.0), 0.1)
+    pursuer, _ = sim.poses_1v1
     assert pursuer.x == pytest.approx(WALL_X - radius, abs=0.01)
-    sim.step(Velocity(0.0, 1.0), Velocity(0.0, 0.0), 0.5)  # it may still turn at the wall
-    assert sim.poses[0].theta == pytest.approx(0.5)
-    sim.reset(Pose(1.0, 1.0, 0.0), Pose(WALL_X + 1.0, 1.0, math.pi))
+    sim.step_1v1(Velocity(0.0, 1.0), Velocity(0.0, 0.0), 0.5)  # it may still turn at the wall
+    assert sim.poses_1v1[0].theta == pytest.approx(0.5)
+    sim.reset_1v1(Pose(1.0, 1.0, 0.0), Pose(WALL_X + 1.0, 1.0, math.pi))
     for _ in range(60):  # the evader from the other side
-        sim.step(Velocity(0.0, 0.0), Velocity(1.0, 0.0), 0.1)
-    assert sim.poses[1].x > WALL_X + 0.1
+        sim.step_1v1(Velocity(0.0, 0.0), Velocity(1.0, 0.0), 0.1)
+    assert sim.poses_1v1[1].x > WALL_X + 0.1
 
 
 def test_a_start_inside_a_wall_is_refused(context):
     sim = make_sim(context)
     try:
         with pytest.raises(ValueError, match="inside a wall"):
-            sim.reset(Pose(WALL_X + 0.05, 1.0, 0.0), Pose(3.5, 2.0, 0.0))
+            sim.reset_1v1(Pose(WALL_X + 0.05, 1.0, 0.0), Pose(3.5, 2.0, 0.0))
     finally:
         sim.close()
 
@@ -101,8 +101,8 @@ def test_a_start_inside_a_wall_is_refused(context):
 def test_camera_depth_to_a_wall_and_the_floor(context, tilt):
     sim = make_sim(context, camera_tilt=tilt, width=160, height=120)
     try:
-        sim.reset(Pose(0.5, 1.0, 0.0), Pose(3.5, 2.5, 0.0))
-        frame = sim.sense(0.0)
+        sim.reset_1v1(Pose(0.5, 1.0, 0.0), Pose(3.5, 2.5, 0.0))
+        frame = sim.sense_1v1(0.0)
         height, width = frame.depth.shape
         assert (width, height) == (160, 120) and frame.rgb.shape == (120, 160, 3)
         # Pixel (59, 80) has its centre at the principal point: it looks along the axis.
@@ -121,7 +121,7 @@ def test_camera_depth_to_a_wall_and_the_floor(context, tilt):
 
 
 def test_the_robot_never_sees_itself_and_the_floor_is_labelled(sim):
-    frame = sim.sense(0.0)
+    frame = sim.sense_1v1(0.0)
     labels = frame.labels
     assert not np.any(frame.segmentation == labels["pursuer"])
     assert np.any(frame.segmentation == labels["floor"])
@@ -131,12 +131,12 @@ def test_the_robot_never_sees_itself_and_the_floor_is_labelled(sim):
 def test_frames_are_rendered_at_camera_hz_and_reused_between(context):
     sim = make_sim(context, camera_hz=5.0)
     try:
-        sim.reset(Pose(0.5, 1.0, 0.0), Pose(1.5, 1.2, 0.0))
-        first = sim.sense(0.0)
-        sim.step(Velocity(0.0, 0.5), Velocity(0.0, 0.0), 0.1)
-        assert sim.sense(0.1) is first
-        sim.step(Velocity(0.0, 0.5), Velocity(0.0, 0.0), 0.1)
-        second = sim.sense(0.2)
+        sim.reset_1v1(Pose(0.5, 1.0, 0.0), Pose(1.5, 1.2, 0.0))
+        first = sim.sense_1v1(0.0)
+        sim.step_1v1(Velocity(0.0, 0.5), Velocity(0.0, 0.0), 0.1)
+        assert sim.sense_1v1(0.1) is first
+        sim.step_1v1(Velocity(0.0, 0.5), Velocity(0.0, 0.0), 0.1)
+        second = sim.sense_1v1(0.2)
         assert second is not first and second.time == 0.2
         assert second.camera_pose.theta == pytest.approx(0.1)
     finally:
@@ -158,8 +158,8 @@ def test_reset_close_cycles_keep_memory_flat(context):
 
     def cycle():
         sim = make_sim(context)
-        sim.reset(Pose(0.5, 1.0, 0.0), Pose(1.5, 1.2, 0.0))
-        sim.sense(0.0)
+        sim.reset_1v1(Pose(0.5, 1.0, 0.0), Pose(1.5, 1.2, 0.0))
+        sim.sense_1v1(0.0)
         sim.close()
         assert sim._client is None
 

@@ -42,8 +42,8 @@ def scene(context):
 )
 def test_the_evader_in_front_is_found_and_placed_within_10_cm(scene, context, x, y, heading):
     sim, detector = scene
-    sim.reset(Pose(0.3, 1.0, 0.0), Pose(x, y, heading))
-    detection = detector.detect(sim.sense(0.0))
+    sim.reset_1v1(Pose(0.3, 1.0, 0.0), Pose(x, y, heading))
+    detection = detector.detect(sim.sense_1v1(0.0))
     assert detection is not None
     assert math.hypot(detection.position[0] - x, detection.position[1] - y) < 0.10
     # Depth is along the optical axis to the body's visible surface, in front of its axis.
@@ -64,10 +64,10 @@ def test_no_detection_behind_a_wall_behind_the_camera_or_beyond_range(scene, con
         Pose(2.6, 1.0, 0.0),
         Pose(1.5, 2.7, 0.0),
     ):  # behind the wall; pursuer looks at it
-        sim.reset(Pose(0.5, 1.0, 0.0), evader)
-        assert detector.detect(sim.sense(0.0)) is None
-    sim.reset(Pose(1.0, 1.0, math.pi), Pose(1.6, 1.0, 0.0))  # behind the camera
-    assert detector.detect(sim.sense(0.0)) is None
+        sim.reset_1v1(Pose(0.5, 1.0, 0.0), evader)
+        assert detector.detect(sim.sense_1v1(0.0)) is None
+    sim.reset_1v1(Pose(1.0, 1.0, math.pi), Pose(1.6, 1.0, 0.0))  # behind the camera
+    assert detector.detect(sim.sense_1v1(0.0)) is None
 
 
 def test_an_evader_beyond_the_camera_range_is_not_detected(context):
@@ -77,10 +77,10 @@ def test_an_evader_beyond_the_camera_range_is_not_detected(context):
     sim = PybulletSimulator(PybulletSimulator.Config(), near, np.random.default_rng(0))
     detector = SegmentationDetector(SegmentationDetector.Config(), near, np.random.default_rng(0))
     try:
-        sim.reset(Pose(0.3, 1.0, 0.0), Pose(1.7, 1.0, 0.0))
-        assert detector.detect(sim.sense(0.0)) is None
-        sim.reset(Pose(0.3, 1.0, 0.0), Pose(0.9, 1.0, 0.0))
-        assert detector.detect(sim.sense(0.0)) is not None
+        sim.reset_1v1(Pose(0.3, 1.0, 0.0), Pose(1.7, 1.0, 0.0))
+        assert detector.detect(sim.sense_1v1(0.0)) is None
+        sim.reset_1v1(Pose(0.3, 1.0, 0.0), Pose(0.9, 1.0, 0.0))
+        assert detector.detect(sim.sense_1v1(0.0)) is not None
     finally:
         sim.close()
 
@@ -101,8 +101,8 @@ def test_the_perception_model_holds_delays_and_degrades_segmentation_detections(
     slow = SegmentationDetector(config, context, np.random.default_rng(0))
     delivered, raw = [], []
     for k in range(14):
-        sim.reset(Pose(0.3, 1.0, 0.0), Pose(1.2 + 0.02 * k, 1.0, 0.0))
-        frame = sim.sense(0.1 * k)
+        sim.reset_1v1(Pose(0.3, 1.0, 0.0), Pose(1.2 + 0.02 * k, 1.0, 0.0))
+        frame = sim.sense_1v1(0.1 * k)
         delivered.append(slow.detect(frame))
         raw.append(exact.detect(frame))
     assert delivered[:2] == [None, None]

@@ -45,8 +45,8 @@ def detector(context, **options) -> PersonDetector:
 @pytest.mark.parametrize("heading", [0.0, 3.0])
 def test_finds_the_person_and_its_box_and_place_match_the_segmentation(room, heading):
     context, sim = room
-    sim.reset(Pose(0.3, 2.0, 0.0), Pose(4.0, 2.1, heading))  # 3.7 m ahead, whole in view
-    frame = sim.sense(0.0)
+    sim.reset_1v1(Pose(0.3, 2.0, 0.0), Pose(4.0, 2.1, heading))  # 3.7 m ahead, whole in view
+    frame = sim.sense_1v1(0.0)
     truth = SegmentationDetector(
         SegmentationDetector.Config(), context, np.random.default_rng(0)
     ).detect(frame)
@@ -60,8 +60,8 @@ def test_finds_nothing_in_an_empty_room(room):
     context, sim = room
     person = detector(context)
     for k in range(4):  # looking at walls, floor and corners; the person behind the camera
-        sim.reset(Pose(1.0, 1.0 + 0.6 * k, 0.4 - 0.3 * k), Pose(0.4, 2.0, 0.0))
-        frame = sim.sense(0.0)
+        sim.reset_1v1(Pose(1.0, 1.0 + 0.6 * k, 0.4 - 0.3 * k), Pose(0.4, 2.0, 0.0))
+        frame = sim.sense_1v1(0.0)
         assert not np.any(frame.segmentation == sim.labels["evader"])
         assert person.detect(frame) is None
 
@@ -71,8 +71,8 @@ def test_tracks_the_person_between_detections(room):
     person = detector(context, redetect_every=3)
     sources = []
     for k in range(6):  # walking across the view, 5 cm per frame
-        sim.reset(Pose(0.3, 2.0, 0.0), Pose(4.0, 1.8 + 0.05 * k, 3.0))
-        found = person.detect(sim.sense(0.1 * k))
+        sim.reset_1v1(Pose(0.3, 2.0, 0.0), Pose(4.0, 1.8 + 0.05 * k, 3.0))
+        found = person.detect(sim.sense_1v1(0.1 * k))
         assert found is not None
         sources.append(person.source)
     assert sources == ["detect", "track", "track", "detect", "track", "track"]

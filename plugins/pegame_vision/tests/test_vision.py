@@ -40,8 +40,8 @@ def walk():
     frames = []
     try:
         for k in range(70):
-            sim.reset(Pose(0.5, 2.0, 0.004 * k), Pose(3.0, 0.3 + 0.05 * k, math.pi / 2))
-            frame = sim.sense(0.1 * k)
+            sim.reset_1v1(Pose(0.5, 2.0, 0.004 * k), Pose(3.0, 0.3 + 0.05 * k, math.pi / 2))
+            frame = sim.sense_1v1(0.1 * k)
             frames.append((frame, reference.detect(frame)))
     finally:
         sim.close()
