@@ -71,6 +71,7 @@ __all__ = [
     "Recorder",
     "Region",
     "SensorFrame",
+    "OneOnOneEstimator",
     "OneOnOneSimulator",
     "Simulator",
     "Strategy",
@@ -388,60 +389,80 @@ class Detector(Plugin):
 
 
 class Estimator(Plugin):
-    """Estimates the evader's position from the pursuer's detections and what it sees.
+    """Estimates one evader's position from every pursuer's detection of it and what the
+    pursuers see (a 1v1 game has one pursuer).
 
     It is given the map (``context.grid``) and the evader's max speed
-    (``context.evader.v_max``), never the true evader pose.
+    (``context.evader.v_max``), never the true evader pose. An estimator that takes one
+    pursuer's detection at a time subclasses :class:`OneOnOneEstimator` instead.
     """
 
     @abstractmethod
-    def reset(self, pursuer: Pose, detection: Detection | None, region: Region) -> Belief:
+    def reset(
+        self, pursuers: Sequence[Pose], detections: Sequence[Detection | None], region: Region
+    ) -> Belief:
         """Start a new game; the evader is in view at the start (the paper's protocol).
 
-        :param pursuer: the pursuer's pose (map frame).
-        :param detection: the first tick's detection, or None when the detector missed.
-        :param region: the cells the pursuer sees at that pose (its visibility region).
+        :param pursuers: every pursuer's pose (map frame), in member order.
+        :param detections: each pursuer's detection of this evader at the first tick, or
+            None where its detector missed.
+        :param region: the cells the pursuers see (the union of their visibility regions).
         :returns: the initial belief about the evader's position.
         """
 
     @abstractmethod
     def update(
-        self, dt: float, pursuer: Pose, detection: Detection | None, region: Region
-    ) -> Belief:
-        """Predict dt seconds (s) ahead and correct with this tick's detection (or its
-        absence) and the pursuer's visibility region (``region.mask`` is a bool (H, W) mask
-        over the grid; ``region.holds(cells)`` answers for a few cells, at a fraction of
-        the cost).
-
-        :param dt: the time since the last update (s), one control period.
-        :param pursuer: the pursuer's pose at this tick (map frame).
-        :param detection: this tick's detection, or None (negative information: the evader
-            is not in ``region``, unless the detector missed it).
-        :param region: the cells the pursuer sees (its visibility region, or a team's union).
-        :returns: the belief about the evader's position after this tick.
-        """
-
-    def reset_team(
-        self, pursuers: Sequence[Pose], detections: Sequence[Detection | None], region: Region
-    ) -> Belief:
-        """:meth:`reset` for a team: every pursuer's pose and detection of this
-        estimator's evader, and the union of their regions. The default fuses the
-        detections (:func:`fuse_detections`) and plays :meth:`reset`."""
-        pursuer, detection = fuse_detections(pursuers, detections)
-        return self.reset(pursuer, detection, region)
-
-    def update_team(
         self,
         dt: float,
         pursuers: Sequence[Pose],
         detections: Sequence[Detection | None],
         region: Region,
     ) -> Belief:
-        """:meth:`update` for a team (arguments as :meth:`reset_team`): the default fuses
-        the detections and plays :meth:`update` with the union region, so the negative
-        information is every pursuer's."""
+        """Predict dt seconds (s) ahead and correct with this tick's detections (or their
+        absence) and the pursuers' visibility region (``region.mask`` is a bool (H, W) mask
+        over the grid; ``region.holds(cells)`` answers for a few cells, at a fraction of
+        the cost).
+
+        :param dt: the time since the last update (s), one control period.
+        :param pursuers: every pursuer's pose at this tick (map frame).
+        :param detections: each pursuer's detection of this evader, or None (negative
+            information: the evader is not in ``region``, unless the detectors missed it).
+        :param region: the cells the pursuers see (the union of their regions).
+        :returns: the belief about the evader's position after this tick.
+        """
+
+
+class OneOnOneEstimator(Estimator):
+    """The small adapter for an estimator fed by one detection at a time: write
+    :meth:`reset_1v1` and :meth:`update_1v1`; against a team the pursuers' detections
+    are fused first (:func:`fuse_detections`), with the union of their regions, so the
+    negative information is every pursuer's."""
+
+    @abstractmethod
+    def reset_1v1(self, pursuer: Pose, detection: Detection | None, region: Region) -> Belief:
+        """:meth:`Estimator.reset` for one pursuer's pose and detection (or None)."""
+
+    @abstractmethod
+    def update_1v1(
+        self, dt: float, pursuer: Pose, detection: Detection | None, region: Region
+    ) -> Belief:
+        """:meth:`Estimator.update` for one pursuer's pose and detection (or None)."""
+
+    def reset(
+        self, pursuers: Sequence[Pose], detections: Sequence[Detection | None], region: Region
+    ) -> Belief:
         pursuer, detection = fuse_detections(pursuers, detections)
-        return self.update(dt, pursuer, detection, region)
+        return self.reset_1v1(pursuer, detection, region)
+
+    def update(
+        self,
+        dt: float,
+        pursuers: Sequence[Pose],
+        detections: Sequence[Detection | None],
+        region: Region,
+    ) -> Belief:
+        pursuer, detection = fuse_detections(pursuers, detections)
+        return self.update_1v1(dt, pursuer, detection, region)
 
 
 def fuse_detections(
@@ -451,6 +472,8 @@ def fuse_detections(
     of the pursuer it is credited to: the nearest detection (smallest depth, the least
     noisy) placed at the mean of all the detected positions (m, map frame), the fusion
     of equally trusted measurements of one point. (pursuers[0], None) when none detects."""
+    if len(detections) == 1:  # one pursuer: its own
+        return pursuers[0], detections[0]
     seen = [(d.depth, i, d) for i, d in enumerate(detections) if d is not None]
     if not seen:
         return pursuers[0], None

@@ -172,14 +172,14 @@ def bench_decisions(
         cls = registry.load("estimator", "particle_filter")
         pf = cls(registry.make_config("estimator", cls, {}), context, np.random.default_rng(0))
         p0 = pairs[0][0]
-        pf.reset(p0, None, VisibilityRegion(grid, p0, camera))
+        pf.reset((p0,), (None,), VisibilityRegion(grid, p0, camera))
         # Regions computed beforehand: the step is timed without its visibility region.
         masks = [MaskRegion(visibility_region(grid, p, camera)) for p, _ in pairs]
         it = iter(list(zip(pairs, masks)) * 2)
 
         def pf_step() -> Belief:
             (p, _), mask = next(it)
-            return pf.update(0.1, p, None, mask)
+            return pf.update(0.1, (p,), (None,), mask)
 
         out["pf_step_ms"] = median_ms(pf_step, repeat)
         if pursuer_name in registry.available("pursuer"):
@@ -192,7 +192,7 @@ def bench_decisions(
 
             def pursuer_decision() -> Plan:
                 (p, _), mask = next(it2)
-                belief = pf.update(0.1, p, None, mask)
+                belief = pf.update(0.1, (p,), (None,), mask)
                 return pursuer.decide(PursuerObservation(0.0, p, None, belief, mask))
 
             out["pursuer_decision_ms"] = median_ms(pursuer_decision, repeat)

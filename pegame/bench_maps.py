@@ -124,7 +124,7 @@ class _Players:
         reset beforehand (not timed) over the region, as just after the evader left it."""
         from pegame.api import PursuerObservation
 
-        belief = self.estimator.update(0.1, p, None, region)
+        belief = self.estimator.update(0.1, (p,), (None,), region)
         self.pursuer.decide(PursuerObservation(0.0, p, None, belief, region))
 
 
@@ -137,7 +137,7 @@ def measure_parts(yaml_path: str, repeat: int) -> dict[str, float]:
         start = time.perf_counter()
         players = _Players(load_map(path))
         p, e, region = players.start()
-        players.estimator.reset(p, None, region)
+        players.estimator.reset((p,), (None,), region)
         players.pursuer.reset(p)
         players.evader_decision(p, e)
         players.pursuer_decision(p, region)
@@ -147,7 +147,7 @@ def measure_parts(yaml_path: str, repeat: int) -> dict[str, float]:
         tic = time.perf_counter()
         players.evader_decision(p, e)
         evader_ms = 1e3 * (time.perf_counter() - tic)
-        players.estimator.reset(p, None, region)
+        players.estimator.reset((p,), (None,), region)
         tic = time.perf_counter()
         players.pursuer_decision(p, region)
         timed.append((evader_ms, 1e3 * (time.perf_counter() - tic)))

@@ -220,6 +220,10 @@ class TickLoop:
         self.evader_first = turn_order == "evader_first"
         self.pursuer_plans = [Plan()] * self.n_pursuers
         self.evader_plans = [Plan()] * self.n_evaders
+        # per-tick constants of the member loops
+        self._pursuer_ids, self._evader_ids = range(self.n_pursuers), range(self.n_evaders)
+        self._no_regions: tuple[None, ...] = (None,) * self.n_pursuers
+        self._no_beliefs = (EMPTY_BELIEF,) * self.n_evaders
 
     @property
     def done(self) -> bool:
@@ -296,72 +300,73 @@ class TickLoop:
 
     def _sense(self, regions: tuple[VisibilityRegion, ...] | None = None) -> None:
         """The current tick's poses, frames, detections, regions, beliefs and in_view;
-        ``regions``: the pursuers' regions already built for their current poses, if any."""
-        grid, camera, radius = self.context.grid, self.context.camera, self.context.evader.radius
-        self.pursuers, self.evaders = self.sim.poses
-        self.frames: tuple[SensorFrame, ...] = self.sim.sense(self.time)
-        detections = []
-        for frame, row in zip(self.frames, self.detectors):  # loops, not comprehensions: per tick
+        ``regions``: the pursuers' regions already built for their current poses, if any.
+        (Loops, not comprehensions, here and in :meth:`advance`: each comprehension is a
+        function call in Python 3.11, and these run every tick.)"""
+        context = self.context
+        grid, camera, radius = context.grid, context.camera, context.evader.radius
+        pursuers, evaders = self.pursuers, self.evaders = self.sim.poses
+        frames = self.frames = self.sim.sense(self.time)
+        detections: list[tuple[Detection | None, ...]] = []
+        for frame, pair_detectors in zip(frames, self.detectors):
             if self.n_evaders == 1:  # one evader: nobody to tell apart
-                detections.append((row[0].detect(frame),))
+                detections.append((pair_detectors[0].detect(frame),))
                 continue
             seen = []
-            for j, detector in enumerate(row):
+            for j, detector in enumerate(pair_detectors):
                 seen.append(_identified(detector.detect(frame.about(j)), j))
             detections.append(tuple(seen))
         self.detections = tuple(detections)
-        self.regions = (None,) * self.n_pursuers
-        self.union = None
-        self.beliefs: tuple[Belief, ...] = (EMPTY_BELIEF,) * self.n_evaders
         if self.estimate:
-            built = regions or tuple(
-                [VisibilityRegion(grid, pose, camera) for pose in self.pursuers]
-            )
-            union = built[0] if self.n_pursuers == 1 else UnionRegion(built)
-            self.regions, self.union = built, union
-            self.beliefs = tuple(
-                [self._estimate(j, built[0], union) for j in range(self.n_evaders)]
-            )
+            if regions is None:
+                built = []
+                for pose in pursuers:
+                    built.append(VisibilityRegion(grid, pose, camera))
+                regions = tuple(built)
+            union = regions[0] if self.n_pursuers == 1 else UnionRegion(regions)
+            self.regions, self.union = regions, union
+            beliefs = []
+            # each evader's estimator, with every pursuer's detection of it
+            for estimator, seen_by in zip(self.estimators, zip(*self.detections)):
+                if self.step == 0:
+                    beliefs.append(estimator.reset(pursuers, seen_by, union))
+                else:
+                    beliefs.append(estimator.update(context.control_dt, pursuers, seen_by, union))
+            self.beliefs = tuple(beliefs)
+        else:
+            self.regions, self.union, self.beliefs = self._no_regions, None, self._no_beliefs
         in_views = []
-        for p in self.pursuers:
-            in_views.append(
-                tuple([body_in_view(grid, camera, p, (e.x, e.y), radius) for e in self.evaders])
-            )
+        for pursuer in pursuers:
+            sees = []
+            for evader in evaders:
+                sees.append(body_in_view(grid, camera, pursuer, (evader.x, evader.y), radius))
+            in_views.append(tuple(sees))
         self.in_views = tuple(in_views)
-
-    def _estimate(self, j: int, region: Region, union: Region) -> Belief:
-        """Evader j's estimator, reset at tick 0 and updated after, by every pursuer;
-        ``region``: pursuer 0's region, ``union``: the union of the pursuers' regions."""
-        estimator = self.estimators[j]
-        if self.n_pursuers == 1:  # the 1v1 interface: one pursuer, its region
-            pursuer, detection = self.pursuers[0], self.detections[0][j]
-            if self.step == 0:
-                return estimator.reset(pursuer, detection, region)
-            return estimator.update(self.context.control_dt, pursuer, detection, region)
-        detections = [row[j] for row in self.detections]
-        if self.step == 0:
-            return estimator.reset_team(self.pursuers, detections, union)
-        return estimator.update_team(self.context.control_dt, self.pursuers, detections, union)
 
     def pursuer_observation(self, i: int = 0) -> PursuerObservation:
         """What pursuer ``i`` is given at this tick (needs ``estimate``)."""
         j = i % self.n_evaders
         regions, union = self.regions, self.union
-        if not _built(regions) or union is None:
+        if union is None or not _built(regions):
             raise RuntimeError("A pursuer's observation needs its region: estimate=True.")
         team = None
         if not self.solo:
             team = PursuerTeam(i, j, self.pursuers, self.detections, self.beliefs, regions, union)
         return PursuerObservation(
-            self.time, self.pursuers[i], self.detections[i][j], self.beliefs[j], regions[i], team
+            self.time,
+            self.pursuers[i],
+            self.detections[i][j],
+            self.beliefs[j],
+            regions[i],
+            team,
         )
 
     def evader_observation(self, j: int = 0) -> EvaderObservation:
         """What evader ``j`` is given at this tick: the pursuer nearest to it and the
         union of the pursuers' regions."""
-        me = self.evaders[j]
-        near = nearest(self.pursuers, me)
-        return EvaderObservation(self.time, me, self.pursuers[near], self.union, self.pursuers, j)
+        me, pursuers = self.evaders[j], self.pursuers
+        near = pursuers[0] if self.n_pursuers == 1 else pursuers[nearest(pursuers, me)]
+        return EvaderObservation(self.time, me, near, self.union, pursuers, j)
 
     def advance(self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None = None) -> Tick:
         """Play the current tick with the external roles' ``commands`` (role -> velocity,
@@ -373,72 +378,88 @@ class TickLoop:
         deciding = self.step % self.decide_every == 0
         evaders, pursuers = self.evader_strategies, self.pursuer_strategies
         if self.evader_first:
-            # The evaders' turn, on the world after the pursuers' last move: their own
-            # poses, the pursuers', and the pursuers' regions (kept for the sensing that
-            # follows, since the pursuers do not move in the evaders' turn).
-            self.pursuers, self.evaders = self.sim.poses
-            grid, camera = self.context.grid, self.context.camera
-            regions = tuple(VisibilityRegion(grid, pose, camera) for pose in self.pursuers)
-            self.regions = regions
-            self.union = regions[0] if self.n_pursuers == 1 else UnionRegion(regions)
-            first = [self.evader_observation(j) for j in range(self.n_evaders)]
-            if deciding:
-                self.evader_plans = [s.decide(o) for s, o in zip(evaders, first)]
-            commanded["evader"] = [s.control(o) for s, o in zip(evaders, first)]
-            self._integrate(evaders=commanded["evader"])
-            self._sense(regions)
+            self._evaders_turn(deciding, commanded)
         e_obs: list[EvaderObservation] | None = None
         if not self.evader_first and "evader" not in self.external:
-            e_obs = [self.evader_observation(j) for j in range(self.n_evaders)]
-        p_obs = (
-            [self.pursuer_observation(i) for i in range(self.n_pursuers)]
-            if "pursuer" not in self.external
-            else None
-        )
+            e_obs = []
+            for j in self._evader_ids:
+                e_obs.append(self.evader_observation(j))
+        p_obs: list[PursuerObservation] | None = None
+        if "pursuer" not in self.external:
+            p_obs = []
+            for i in self._pursuer_ids:
+                p_obs.append(self.pursuer_observation(i))
         if deciding:  # the evaders first, then the pursuers (paper)
             if e_obs is not None:
                 self.evader_plans = [s.decide(o) for s, o in zip(evaders, e_obs)]
             if p_obs is not None:
                 self.pursuer_plans = [s.decide(o) for s, o in zip(pursuers, p_obs)]
         if p_obs is not None:
-            commanded["pursuer"] = [s.control(o) for s, o in zip(pursuers, p_obs)]
+            controlled = commanded["pursuer"] = []
+            for pursuer, p_ob in zip(pursuers, p_obs):
+                controlled.append(pursuer.control(p_ob))
         if e_obs is not None:
-            commanded["evader"] = [s.control(o) for s, o in zip(evaders, e_obs)]
+            controlled = commanded["evader"] = []
+            for evader, e_ob in zip(evaders, e_obs):
+                controlled.append(evader.control(e_ob))
         p_cmds, e_cmds = commanded["pursuer"], commanded["evader"]
-        in_view = self.in_views[0][0] if self.solo else self.in_view
-        if self.solo:
-            detected = self.detections[0][0] is not None
-            self.tracking.add(self.pursuers[0], self.evaders[0], detected, in_view, self.beliefs[0])
-            losses = self.losses.add_one(self.pursuers[0], self.evaders[0], detected, p_cmds[0])
+        tick = self._measure(deciding, p_cmds, e_cmds)
+        self.recorder.log(tick)
+        if self.evader_first:
+            self._integrate(pursuers=p_cmds)
+            self._next_tick()
         else:
+            sim, dt = self.sim, self.context.control_dt / self.substeps
+            for _ in range(self.substeps):
+                sim.step(p_cmds, e_cmds, dt)
+            self._next_tick()
+            self._sense()  # also after the last tick: the environments observe the final state
+        return tick
+
+    def _evaders_turn(self, deciding: bool, commanded: dict[str, Sequence[Velocity]]) -> None:
+        """``evader_first``: the evaders observe, decide (at a decision tick), command and
+        move on the world after the pursuers' last move, then the tick is sensed. The
+        pursuers' regions are built first and kept for the sensing, since the pursuers do
+        not move in the evaders' turn."""
+        evaders = self.evader_strategies
+        self.pursuers, self.evaders = self.sim.poses
+        grid, camera = self.context.grid, self.context.camera
+        regions = tuple(VisibilityRegion(grid, pose, camera) for pose in self.pursuers)
+        self.regions = regions
+        self.union = regions[0] if self.n_pursuers == 1 else UnionRegion(regions)
+        observations = [self.evader_observation(j) for j in self._evader_ids]
+        if deciding:
+            self.evader_plans = [s.decide(o) for s, o in zip(evaders, observations)]
+        commanded["evader"] = [s.control(o) for s, o in zip(evaders, observations)]
+        self._integrate(evaders=commanded["evader"])
+        self._sense(regions)
+
+    def _measure(
+        self, deciding: bool, p_cmds: Sequence[Velocity], e_cmds: Sequence[Velocity]
+    ) -> Tick:
+        """Add the tick to the game's measures and losses of track; the tick."""
+        pursuers, evaders, detections = self.pursuers, self.evaders, self.detections
+        if self.solo:
+            in_view, detected = self.in_views[0][0], detections[0][0] is not None
+            self.tracking.add(pursuers[0], evaders[0], detected, in_view, self.beliefs[0])
+            losses = self.losses.add_one(pursuers[0], evaders[0], detected, p_cmds[0])
+            team = None
+        else:
+            in_view = self.in_view
             self.team_metrics.add(
-                self.pursuers,
-                self.evaders,
-                self.detections,
+                pursuers,
+                evaders,
+                detections,
                 self.in_views,
                 self.beliefs,
                 self.union if deciding else None,
             )
-            losses = self.losses.add(self.pursuers, self.evaders, self.detections, p_cmds)
-        tick = Tick(
-            self.step,
-            self.time,
-            self.pursuers[0],
-            self.evaders[0],
-            self.frames[0],
-            self.detections[0][0],
-            self.beliefs[0],
-            self.regions[0],
-            in_view,
-            (p_cmds[0], e_cmds[0]),
-            (self.pursuer_plans[0], self.evader_plans[0]),
-            None
-            if self.solo
-            else TeamTick(
-                self.pursuers,
-                self.evaders,
+            losses = self.losses.add(pursuers, evaders, detections, p_cmds)
+            team = TeamTick(
+                pursuers,
+                evaders,
                 self.frames,
-                self.detections,
+                detections,
                 self.beliefs,
                 self.regions,
                 self.in_views,
@@ -446,18 +467,22 @@ class TickLoop:
                 tuple(e_cmds),
                 tuple(self.pursuer_plans),
                 tuple(self.evader_plans),
-            ),
+            )
+        return Tick(
+            self.step,
+            self.time,
+            pursuers[0],
+            evaders[0],
+            self.frames[0],
+            detections[0][0],
+            self.beliefs[0],
+            self.regions[0],
+            in_view,
+            (p_cmds[0], e_cmds[0]),
+            (self.pursuer_plans[0], self.evader_plans[0]),
+            team,
             losses,
         )
-        self.recorder.log(tick)
-        if self.evader_first:
-            self._integrate(pursuers=p_cmds)
-            self._next_tick()
-        else:
-            self._integrate(p_cmds, e_cmds)
-            self._next_tick()
-            self._sense()  # also after the last tick: the environments observe the final state
-        return tick
 
     def _next_tick(self) -> None:
         self.step += 1
@@ -465,12 +490,12 @@ class TickLoop:
 
     def _commanded(
         self, commands: Mapping[str, Velocity | Sequence[Velocity]] | None
-    ) -> dict[str, list[Velocity]]:
-        """The external roles' commands as one list of velocities per role; ValueError
-        when an external role has none."""
-        commanded = {}
+    ) -> dict[str, Sequence[Velocity]]:
+        """The external roles' commands as one sequence of velocities per role;
+        ValueError when an external role has none."""
+        commanded: dict[str, Sequence[Velocity]] = {}
         for role, command in (commands or {}).items():  # loops, not comprehensions: per tick
-            commanded[role] = [command] if isinstance(command, Velocity) else list(command)
+            commanded[role] = (command,) if isinstance(command, Velocity) else command
         for role in self.external:
             if role not in commanded:
                 missing = [role for role in self.external if role not in commanded]
@@ -495,7 +520,7 @@ class TickLoop:
 
 def _built(regions: tuple[VisibilityRegion | None, ...]) -> TypeGuard[tuple[VisibilityRegion, ...]]:
     """Whether every pursuer's region was built this tick (``estimate``)."""
-    return all(region is not None for region in regions)
+    return None not in regions
 
 
 def _identified(detection: Detection | None, evader: int) -> Detection | None:

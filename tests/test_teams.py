@@ -238,8 +238,8 @@ def test_two_pursuers_detections_shrink_the_kalman_covariance_more_than_one(solo
     one, two = (KalmanEstimator(KalmanEstimator.Config(), solo.context, None) for _ in range(2))
     poses = (Pose(0, 0), Pose(4, 4))
     for estimator, extra in ((one, None), (two, detection_at(3.0, 3.0))):
-        estimator.reset_team(poses, [detection_at(3.0, 3.0), extra], None)
-        belief = estimator.update_team(0.1, poses, [detection_at(3.05, 3.0), extra], None)
+        estimator.reset(poses, [detection_at(3.0, 3.0), extra], None)
+        belief = estimator.update(0.1, poses, [detection_at(3.05, 3.0), extra], None)
     assert np.trace(two._belief().covariance) < np.trace(one._belief().covariance)
     assert belief.mean == pytest.approx((3.0, 3.0), abs=0.1)
 

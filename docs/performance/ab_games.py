@@ -12,9 +12,7 @@ best CPU time (``time.process_time``) of ``--reps`` plays is kept; the report gi
 map, each side's sum over seeds and its ratio to the first side, and the median of the
 per-seed ratios. ``--env`` times PettingZoo episodes (both agents learners, uniformly random
 actions, 900 steps) instead of games. The sides must play the same games: seeds whose tracking rates differ
-are reported. ``--csv PATH`` writes every play. ``--general NAME`` makes side NAME play the
-tick loop's general form (what ``TickLoop._advance_1v1`` saves: the same checkout twice,
-``main=python:. general=python:. --general general``).
+are reported. ``--csv PATH`` writes every play.
 """
 
 from __future__ import annotations
@@ -26,32 +24,12 @@ import subprocess
 import sys
 import time
 
-#: environment variable: a worker with it set plays the general form of every tick
-GENERAL_TICK = "AB_GENERAL_TICK"
-
-
-def general_tick() -> None:
-    """When GENERAL_TICK is set, make every tick loop take its general form (``one_on_one``
-    False: the team's per-member tick), to measure what the fast 1v1 form saves."""
-    if not os.environ.get(GENERAL_TICK):
-        return
-    from pegame.loop import TickLoop
-
-    init = TickLoop.__init__
-
-    def general_init(self, *args, **kwargs):
-        init(self, *args, **kwargs)
-        self.one_on_one = False
-
-    TickLoop.__init__ = general_init
-
 
 def worker() -> None:
     """Read 'MAP SEED' lines; answer 'CPU_SECONDS TRACKING_RATE' per game."""
     from pegame.config import compose
     from pegame.game import Game
 
-    general_tick()
     for env in ("enclosed", "hall"):  # warm up: numba caches, map loads
         Game(compose(["recorder=none", f"env={env}", "game.seed=999", "game.t_max=5"])).play(".")
     print("ready", flush=True)
@@ -70,7 +48,6 @@ def env_worker() -> None:
 
     from pegame.envs.parallel import parallel_env
 
-    general_tick()
     envs = {m: parallel_env(overrides=(f"env={m}",)) for m in ("enclosed", "hall", "brick")}
 
     def episode(env, seed: int) -> float:
@@ -92,12 +69,9 @@ def env_worker() -> None:
         print(f"{time.process_time() - start:.6f} {rate}", flush=True)
 
 
-def start_workers(
-    sides: list[str], script: str, flag: str, general: tuple[str, ...] = ()
-) -> dict[str, subprocess.Popen]:
+def start_workers(sides: list[str], script: str, flag: str) -> dict[str, subprocess.Popen]:
     """One worker process per NAME=PYTHON:CHECKOUT side, running ``script flag`` with the
-    checkout first on PYTHONPATH, each ready (it has printed "ready"), by name; the sides
-    named in ``general`` play the tick loop's general form (:func:`general_tick`)."""
+    checkout first on PYTHONPATH, each ready (it has printed "ready"), by name."""
     workers = {}
     for side in sides:
         name, spec = side.split("=", 1)
@@ -105,11 +79,7 @@ def start_workers(
         workers[name] = subprocess.Popen(
             [python, os.path.abspath(script), flag],
             cwd=os.environ.get("TMPDIR", "/tmp"),
-            env={
-                **os.environ,
-                "PYTHONPATH": os.path.abspath(checkout),
-                GENERAL_TICK: "1" if name in general else "",
-            },
+            env={**os.environ, "PYTHONPATH": os.path.abspath(checkout)},
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -143,14 +113,11 @@ def main() -> None:
     parser.add_argument(
         "--env", action="store_true", help="time PettingZoo episodes of random actions instead"
     )
-    parser.add_argument(
-        "--general", action="append", default=[], help="a side that plays the general tick form"
-    )
     args = parser.parse_args()
     maps = args.maps.split(",")
     seeds = [int(s) for s in args.seed_list.split(",")] if args.seed_list else range(args.seeds)
     flag = "--env-worker" if args.env else "--worker"
-    workers = start_workers(args.sides, __file__, flag, tuple(args.general))
+    workers = start_workers(args.sides, __file__, flag)
     names = list(workers)
     best: dict[str, dict[str, dict[int, float]]] = {n: {m: {} for m in maps} for n in names}
     rows = []

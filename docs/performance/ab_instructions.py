@@ -129,7 +129,7 @@ def _decisions(grid, name: str):
         plugin("pursuer", "smart", 1),
         plugin("evader", "smart", 2),
     )
-    pf.reset(pairs[0][0], None, bench.VisibilityRegion(grid, pairs[0][0], camera))
+    pf.reset((pairs[0][0],), (None,), bench.VisibilityRegion(grid, pairs[0][0], camera))
     pursuer.reset(pairs[0][0])
     evader.reset(pairs[0][1])
 
@@ -138,7 +138,7 @@ def _decisions(grid, name: str):
             if name == "evader":
                 evader.decide(bench.EvaderObservation(0.0, e, p))
                 continue
-            belief = pf.update(0.1, p, None, region)
+            belief = pf.update(0.1, (p,), (None,), region)
             if name == "pursuer":
                 pursuer.decide(bench.PursuerObservation(0.0, p, None, belief, region))
 

@@ -21,7 +21,7 @@ covariance is left as the filter computed it.
 
 The filter starts at the first detection (position = detection, velocity 0 with std
 v_max); before it the belief's mean is None. In a team every pursuer's detection of the
-evader corrects the filter in turn (:meth:`KalmanEstimator.update_team`).
+evader corrects the filter in turn (:meth:`KalmanEstimator.update`).
 """
 
 from __future__ import annotations
@@ -58,34 +58,7 @@ class KalmanEstimator(Estimator):
         super().__init__(config, context, rng)
         self._kf: KalmanFilter | None = None
 
-    def reset(self, pursuer: Pose, detection: Detection | None, visible: Region) -> Belief:
-        """Forget the track; start one at ``detection`` if there is one."""
-        self._kf = None
-        if detection is not None:
-            self._start(detection.position)
-        return self._belief()
-
-    def update(
-        self, dt: float, pursuer: Pose, detection: Detection | None, visible: Region
-    ) -> Belief:
-        """Predict ``dt`` s ahead, then correct with the detection's map position if any."""
-        if self._kf is None:
-            if detection is not None:
-                self._start(detection.position)
-            return self._belief()
-        kf = self._kf
-        kf.F = transition(dt)
-        kf.Q = Q_discrete_white_noise(
-            dim=2, dt=dt, var=self.config.accel_std**2, block_size=2, order_by_dim=False
-        )
-        kf.predict()
-        _clamp_speed(kf, self.context.evader.v_max)
-        if detection is not None:
-            kf.update(np.asarray(detection.position, dtype=float))
-            _clamp_speed(kf, self.context.evader.v_max)
-        return self._belief()
-
-    def reset_team(
+    def reset(
         self, pursuers: Sequence[Pose], detections: Sequence[Detection | None], region: Region
     ) -> Belief:
         """Forget the track; start one at the first detection and correct it with the others."""
@@ -95,7 +68,7 @@ class KalmanEstimator(Estimator):
             self._correct(self._start(seen[0].position), seen[1:])
         return self._belief()
 
-    def update_team(
+    def update(
         self,
         dt: float,
         pursuers: Sequence[Pose],
@@ -104,13 +77,17 @@ class KalmanEstimator(Estimator):
     ) -> Belief:
         """Predict ``dt`` s ahead, then correct with every pursuer's detection in turn
         (independent measurements of one position: sequential updates are the batch
-        update)."""
-        seen = [d for d in detections if d is not None]
+        update); before the first detection, start at it."""
         kf = self._kf
         if kf is None:
-            return self.reset_team(pursuers, detections, region)
-        self.update(dt, pursuers[0], seen[0] if seen else None, region)  # updates kf
-        self._correct(kf, seen[1:])
+            return self.reset(pursuers, detections, region)
+        kf.F = transition(dt)
+        kf.Q = Q_discrete_white_noise(
+            dim=2, dt=dt, var=self.config.accel_std**2, block_size=2, order_by_dim=False
+        )
+        kf.predict()
+        _clamp_speed(kf, self.context.evader.v_max)
+        self._correct(kf, [d for d in detections if d is not None])
         return self._belief()
 
     def _correct(self, kf: KalmanFilter, detections: Sequence[Detection]) -> None:

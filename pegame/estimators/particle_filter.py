@@ -63,7 +63,7 @@ import numpy as np
 from numba import njit
 from scipy.ndimage import distance_transform_edt
 
-from pegame.api import Context, Estimator
+from pegame.api import Context, OneOnOneEstimator
 from pegame.errors import MapError, require
 from pegame.estimators.resampling import RESAMPLERS, ThresholdResampler, effective_sample_size
 from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
@@ -229,7 +229,7 @@ def _moments(particles: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np
     return np.array([x0 + sx, y0 + sy]), np.array([[sxx - sx * sx, cxy], [cxy, syy - sy * sy]])
 
 
-class ParticleFilter(Estimator):
+class ParticleFilter(OneOnOneEstimator):
     """SIS particle filter over the evader's (x, y, theta), with negative information."""
 
     description = "SIS particle filter over the evader's pose with negative information (paper)."
@@ -286,7 +286,7 @@ class ParticleFilter(Estimator):
 
     # ------------------------------------------------------------------ interface
 
-    def reset(self, pursuer: Pose, detection: Detection | None, visible: Region) -> Belief:
+    def reset_1v1(self, pursuer: Pose, detection: Detection | None, visible: Region) -> Belief:
         """Draw the initial particles: around the detection if any (N(z, init_spread) on
         free cells), else uniformly over the free cells inside ``visible`` (or over all
         free cells when none is visible); headings uniform, weights 1/N."""
@@ -305,7 +305,7 @@ class ParticleFilter(Estimator):
         self.weights = np.full(n, 1.0 / n)
         return self._belief(float(n), resampled=False)
 
-    def update(
+    def update_1v1(
         self, dt: float, pursuer: Pose, detection: Detection | None, visible: Region
     ) -> Belief:
         """Predict ``dt`` s with the unicycle model, weigh by the detection (or its absence)
@@ -319,13 +319,13 @@ class ParticleFilter(Estimator):
     def update_reference(
         self, dt: float, pursuer: Pose, detection: Detection | None, visible: Region
     ) -> Belief:
-        """:meth:`update` in plain numpy: the reference the tests hold the kernels to."""
+        """:meth:`update_1v1` in plain numpy: the reference the tests hold the kernels to."""
         return self._update(dt, detection, visible, reference=True)
 
     def _update(
         self, dt: float, detection: Detection | None, visible: Region, reference: bool
     ) -> Belief:
-        """:meth:`update`, or with ``reference`` :meth:`update_reference`."""
+        """:meth:`update_1v1`, or with ``reference`` :meth:`update_reference`."""
         cfg = self.config
         self._check_shape(visible.shape)  # before any draw
         weigh = self._weigh_reference if reference else self._weigh

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from operator import attrgetter
 
 import numpy as np
 from numba import njit
@@ -248,6 +249,10 @@ class _Agent:
         self._pose = Pose(x, y, theta)
 
 
+#: an agent's pose, read in C by map
+_POSE = attrgetter("pose")
+
+
 class GridSimulator(Simulator):
     """Kinematic unicycles on the occupancy grid, stopped by walls; the camera frame
     carries the ground-truth evader pose for the oracle detector. Plays teams: N
@@ -295,13 +300,13 @@ class GridSimulator(Simulator):
 
     @property
     def poses(self) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
-        return tuple([a.pose for a in self._pursuers]), tuple([a.pose for a in self._evaders])
+        return tuple(map(_POSE, self._pursuers)), tuple(map(_POSE, self._evaders))
 
     def sense(self, time: float) -> tuple[SensorFrame, ...]:
         if len(self._pursuers) == 1 and len(self._evaders) == 1:  # a 1v1 frame: no list
             pose, evader = self._pursuers[0].pose, self._evaders[0].pose
             return (SensorFrame(time=time, camera_pose=pose, evader_truth=evader),)
-        evaders = tuple([a.pose for a in self._evaders])
+        evaders = tuple(map(_POSE, self._evaders))
         return tuple(
             [
                 SensorFrame(

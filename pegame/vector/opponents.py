@@ -172,9 +172,9 @@ class PursuerStrategyOpponent:
             region = VisibilityRegion(grid, pose, camera)
             estimator = self.estimators[game]
             if state.steps[game] == 0:
-                belief = estimator.reset(pose, detection, region)
+                belief = estimator.reset((pose,), (detection,), region)
             else:
-                belief = estimator.update(dt, pose, detection, region)
+                belief = estimator.update(dt, (pose,), (detection,), region)
             self.seen[game] = (detection, region, belief)
 
     def command(

@@ -236,11 +236,11 @@ def pf_mass_in_view_after_a_second_of_misses(hz: float, **params) -> tuple[float
     pf = ParticleFilter(config, ctx, np.random.default_rng(5))
     everywhere, right = np.ones((40, 50), bool), np.zeros((40, 50), bool)
     right[:, 20:] = True  # x >= 2 m
-    belief = pf.reset(ORIGIN, seen_at(2.0, 2.0), MaskRegion(everywhere))
+    belief = pf.reset_1v1(ORIGIN, seen_at(2.0, 2.0), MaskRegion(everywhere))
     inside = belief.particles[:, 0] >= 2.0
     before = belief.weights[inside].sum()
     for _ in range(round(hz)):
-        belief = pf.update(0.0, ORIGIN, None, MaskRegion(right))
+        belief = pf.update_1v1(0.0, ORIGIN, None, MaskRegion(right))
     return before, belief.weights[belief.particles[:, 0] >= 2.0].sum()
 
 

@@ -109,7 +109,7 @@ def test_weights_stay_normalised_over_a_long_run():
     pf = build(ParticleFilter, grid, seed=1, n_particles=500)
     rng = np.random.default_rng(2)
     target = np.array([1.5, 2.0])
-    belief = pf.reset(PURSUER, detection(*target), disc(grid, target, 1.5))
+    belief = pf.reset_1v1(PURSUER, detection(*target), disc(grid, target, 1.5))
     resamples = 0
     for _ in range(300):
         # The target walks at up to 0.4 m/s inside the free part left of the block.
@@ -117,7 +117,7 @@ def test_weights_stay_normalised_over_a_long_run():
         view = disc(grid, rng.uniform([0.5, 0.5], [4.5, 3.5]), 1.2)
         in_region = bool(cell_values(grid, target[None, :], view.mask)[0])
         found = detection(*(target + rng.normal(0.0, 0.1, 2))) if in_region else None
-        belief = pf.update(DT, PURSUER, found, view)
+        belief = pf.update_1v1(DT, PURSUER, found, view)
         w = belief.weights
         assert np.all(np.isfinite(w)) and np.all(w >= 0)
         assert w.sum() == pytest.approx(1.0, abs=1e-9)
@@ -134,19 +134,19 @@ def test_localises_a_stationary_target():
     view = disc(grid, target, 1.5)
     rng = np.random.default_rng(3)
     pf = build(ParticleFilter, grid, seed=4)
-    pf.reset(PURSUER, detection(*(target + rng.normal(0.0, 0.1, 2))), view)
+    pf.reset_1v1(PURSUER, detection(*(target + rng.normal(0.0, 0.1, 2))), view)
     for _ in range(8):
-        belief = pf.update(DT, PURSUER, detection(*(target + rng.normal(0.0, 0.1, 2))), view)
+        belief = pf.update_1v1(DT, PURSUER, detection(*(target + rng.normal(0.0, 0.1, 2))), view)
     assert math.dist(belief.mean, target) < 0.3
 
 
 def test_negative_information_moves_mass_out_of_the_region():
     grid = room()
     pf = build(ParticleFilter, grid, seed=5, rho=0.0, init_spread=0.5)
-    start = pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 2.0))
+    start = pf.reset_1v1(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 2.0))
     view = disc(grid, (2.0, 2.0), 0.5)  # covers the cloud's right part
     before = start.weights[cell_values(grid, start.particles, view.mask)].sum()
-    after = pf.update(0.0, PURSUER, None, view)  # dt 0: only the measurement acts
+    after = pf.update_1v1(0.0, PURSUER, None, view)  # dt 0: only the measurement acts
     inside = cell_values(grid, after.particles, view.mask)
     mass = after.weights[inside].sum()
     assert 0.1 < before < 0.9
@@ -174,13 +174,13 @@ def reference_weights(grid, cfg, particles, prior, found, view):
 def test_weight_update_matches_the_per_particle_reference():
     grid = room()
     pf = build(ParticleFilter, grid, seed=25, n_particles=300, rho=0.0, init_spread=0.6)
-    belief = pf.reset(PURSUER, detection(2.6, 2.0), disc(grid, (2.6, 2.0), 1.0))
+    belief = pf.reset_1v1(PURSUER, detection(2.6, 2.0), disc(grid, (2.6, 2.0), 1.0))
     rng = np.random.default_rng(26)
     for step in range(12):
         view = disc(grid, rng.uniform([1.5, 1.0], [3.0, 3.0]), 0.8)
         found = detection(*rng.normal([2.6, 2.0], 0.1)) if step % 2 else None
         prior = belief.weights
-        belief = pf.update(DT, PURSUER, found, view)
+        belief = pf.update_1v1(DT, PURSUER, found, view)
         expected = reference_weights(grid, pf.config, belief.particles, prior, found, view)
         np.testing.assert_allclose(belief.weights, expected, rtol=1e-9, atol=1e-15)
 
@@ -191,8 +191,8 @@ def test_resampling_happens_exactly_below_rho_times_n():
 
     def first_update(rho):
         pf = build(ParticleFilter, grid, seed=6, n_particles=n, rho=rho, init_spread=0.5)
-        pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
-        return pf.update(DT, PURSUER, detection(1.7, 2.1), disc(grid, (1.5, 2.0), 1.0))
+        pf.reset_1v1(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
+        return pf.update_1v1(DT, PURSUER, detection(1.7, 2.1), disc(grid, (1.5, 2.0), 1.0))
 
     # rho = 0 never resamples, so its weights are the pre-resampling weights of every rho:
     # resampling is the update's last step and the only one rho changes.
@@ -214,11 +214,11 @@ def test_resampled_flag_follows_the_threshold_over_a_run(rho):
     n = 300
     pf = build(ParticleFilter, grid, seed=7, n_particles=n, rho=rho)
     rng = np.random.default_rng(8)
-    pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
+    pf.reset_1v1(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
     flags = []
     for step in range(60):
         found = detection(*rng.normal([1.5, 2.0], 0.1)) if step % 3 else None
-        belief = pf.update(DT, PURSUER, found, disc(grid, (1.5 + 0.02 * step, 2.0), 1.0))
+        belief = pf.update_1v1(DT, PURSUER, found, disc(grid, (1.5 + 0.02 * step, 2.0), 1.0))
         assert belief.resampled == (belief.n_eff < rho * n)
         flags.append(belief.resampled)
     if rho == 0.0:
@@ -241,7 +241,7 @@ def run_side_by_side(grid, steps, seed, **params):
     x0, x1, y0, y1 = grid.extent
     start = detection(x0 + 1.5, y0 + 2.0)
     view = disc(grid, start.position, 1.5)
-    yield fast.reset(PURSUER, start, view), slow.reset(PURSUER, start, view)
+    yield fast.reset_1v1(PURSUER, start, view), slow.reset_1v1(PURSUER, start, view)
     for step in range(steps):
         view = disc(grid, rng.uniform([x0, y0], [x1, y1]), rng.uniform(0.5, 2.0))
         fast_view = slow_view = view
@@ -255,7 +255,7 @@ def run_side_by_side(grid, steps, seed, **params):
                 *rng.uniform([x0, y0], [x1, y1]) if far else rng.normal(start.position, 0.3)
             )
         yield (
-            fast.update(DT, PURSUER, found, fast_view),
+            fast.update_1v1(DT, PURSUER, found, fast_view),
             slow.update_reference(DT, PURSUER, found, slow_view),
         )
         slow.particles, slow.weights = fast.particles, fast.weights
@@ -303,22 +303,22 @@ def test_motion_kernel_matches_the_reference_beyond_the_polynomial_range():
     slow = build(ParticleFilter, grid, seed=5, n_particles=400)
     start = detection(2.0, 2.0)
     view = disc(grid, start.position, 1.0)
-    fast.reset(PURSUER, start, view)
-    slow.reset(PURSUER, start, view)
+    fast.reset_1v1(PURSUER, start, view)
+    slow.reset_1v1(PURSUER, start, view)
     headings = np.where(np.arange(400) % 2, 1e7, -3e9) + fast.particles[:, 2]
     fast.particles = slow.particles = np.column_stack([fast.particles[:, :2], headings])
     assert_same_belief(
-        fast.update(DT, PURSUER, start, view), slow.update_reference(DT, PURSUER, start, view)
+        fast.update_1v1(DT, PURSUER, start, view), slow.update_reference(DT, PURSUER, start, view)
     )
 
 
 def test_vanished_weights_reinitialise_outside_the_view(caplog):
     grid = room()
     pf = build(ParticleFilter, grid, seed=15, miss_factor=0.0)
-    pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.5))
+    pf.reset_1v1(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.5))
     view = disc(grid, (1.5, 2.0), 1.5)  # holds every particle, and the evader is not detected
     with caplog.at_level(logging.DEBUG, logger=LOGGER):
-        belief = pf.update(DT, PURSUER, None, view)
+        belief = pf.update_1v1(DT, PURSUER, None, view)
     assert [r.levelname for r in caplog.records if "vanished" in r.message] == ["DEBUG"]
     assert belief.resampled and belief.n_eff == 0.0
     assert np.all(np.isfinite(belief.particles)) and np.all(np.isfinite(belief.mean))
@@ -327,17 +327,17 @@ def test_vanished_weights_reinitialise_outside_the_view(caplog):
     assert not np.any(cell_values(grid, belief.particles, view.mask))
     # A region over the whole grid: no free cell is left outside it.
     everywhere = MaskRegion(np.ones((grid.height, grid.width), dtype=bool))
-    pf.reset(PURSUER, detection(1.5, 2.0), everywhere)
-    belief = pf.update(DT, PURSUER, None, everywhere)
+    pf.reset_1v1(PURSUER, detection(1.5, 2.0), everywhere)
+    belief = pf.update_1v1(DT, PURSUER, None, everywhere)
     assert np.all(on_free(grid, belief.particles)) and np.all(np.isfinite(belief.weights))
 
 
 def test_a_detection_far_from_every_particle_redraws_around_it(caplog):
     grid = room()
     pf = build(ParticleFilter, grid, seed=16)
-    pf.reset(PURSUER, detection(1.0, 1.0), disc(grid, (1.0, 1.0), 1.0))
+    pf.reset_1v1(PURSUER, detection(1.0, 1.0), disc(grid, (1.0, 1.0), 1.0))
     with caplog.at_level(logging.DEBUG, logger=LOGGER):
-        belief = pf.update(DT, PURSUER, detection(4.2, 3.2), disc(grid, (4.2, 3.2), 1.0))
+        belief = pf.update_1v1(DT, PURSUER, detection(4.2, 3.2), disc(grid, (4.2, 3.2), 1.0))
     assert [r.levelname for r in caplog.records if "lost the track" in r.message] == ["DEBUG"]
     assert math.dist(belief.mean, (4.2, 3.2)) < 0.3
 
@@ -347,12 +347,12 @@ def test_no_weight_remains_on_blocked_cells():
     pf = build(ParticleFilter, grid, seed=17, init_spread=1.0, rho=0.5)
     near_wall = (2.9, 2.0)  # 0.1 m left of the block
     view = disc(grid, near_wall, 1.0)
-    belief = pf.reset(PURSUER, detection(*near_wall), view)
+    belief = pf.reset_1v1(PURSUER, detection(*near_wall), view)
     assert np.all(on_free(grid, belief.particles))
     rng = np.random.default_rng(18)
     for step in range(40):
         found = detection(*rng.normal(near_wall, 0.1)) if step % 2 else None
-        belief = pf.update(DT, PURSUER, found, view)
+        belief = pf.update_1v1(DT, PURSUER, found, view)
         assert np.all(belief.weights[~on_free(grid, belief.particles)] == 0)
         if belief.resampled:
             assert np.all(on_free(grid, belief.particles))
@@ -363,11 +363,11 @@ def test_detection_inside_an_obstacle_starts_on_free_cells(caplog):
     pf = build(ParticleFilter, grid, seed=19)
     inside = (3.25, 2.0)  # the middle of the block
     with caplog.at_level(logging.INFO, logger=LOGGER):
-        belief = pf.reset(PURSUER, detection(*inside), disc(grid, inside, 1.0))
+        belief = pf.reset_1v1(PURSUER, detection(*inside), disc(grid, inside, 1.0))
     assert "blocked cell" in caplog.text
     assert np.all(on_free(grid, belief.particles))
     assert math.dist(belief.mean, inside) < 1.0
-    off_map = pf.reset(PURSUER, detection(-3.0, 2.0), disc(grid, (0.5, 2.0), 1.0))
+    off_map = pf.reset_1v1(PURSUER, detection(-3.0, 2.0), disc(grid, (0.5, 2.0), 1.0))
     assert np.all(on_free(grid, off_map.particles))
 
 
@@ -375,10 +375,10 @@ def test_reset_without_detection_covers_the_visible_free_cells():
     grid = room()
     pf = build(ParticleFilter, grid, seed=20)
     view = disc(grid, (3.0, 2.0), 1.0)  # straddles the block
-    belief = pf.reset(PURSUER, None, view)
+    belief = pf.reset_1v1(PURSUER, None, view)
     assert np.all(cell_values(grid, belief.particles, view.mask & grid.free))
     nothing = MaskRegion(np.zeros((grid.height, grid.width), dtype=bool))
-    belief = pf.reset(PURSUER, None, nothing)
+    belief = pf.reset_1v1(PURSUER, None, nothing)
     assert np.all(on_free(grid, belief.particles))
     assert np.ptp(belief.particles[:, 0]) > 3.5  # spread over the whole room
 
@@ -388,8 +388,8 @@ def test_belief_layout_and_determinism():
     runs = []
     for seed in (21, 21, 22):
         pf = build(ParticleFilter, grid, seed=seed, n_particles=100)
-        pf.reset(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
-        runs.append(pf.update(DT, PURSUER, detection(1.6, 2.0), disc(grid, (1.5, 2.0), 1.0)))
+        pf.reset_1v1(PURSUER, detection(1.5, 2.0), disc(grid, (1.5, 2.0), 1.0))
+        runs.append(pf.update_1v1(DT, PURSUER, detection(1.6, 2.0), disc(grid, (1.5, 2.0), 1.0)))
     belief = runs[0]
     assert isinstance(belief.mean, tuple) and all(type(v) is float for v in belief.mean)
     assert belief.covariance.shape == (2, 2)
@@ -406,7 +406,7 @@ def test_visibility_mask_of_the_wrong_shape_is_rejected():
     grid = room()
     pf = build(ParticleFilter, grid, n_particles=10)
     with pytest.raises(ValueError, match="shape"):
-        pf.reset(PURSUER, None, MaskRegion(np.ones((3, 3), dtype=bool)))
+        pf.reset_1v1(PURSUER, None, MaskRegion(np.ones((3, 3), dtype=bool)))
 
 
 # --------------------------------------------------------------------------- kalman
@@ -422,10 +422,10 @@ def test_kalman_converges_on_a_constant_velocity_track():
     kf = build(KalmanEstimator, grid)
     truth = straight_track(40)
     noise = np.random.default_rng(23).normal(0.0, 0.1, truth.shape)
-    belief = kf.reset(PURSUER, detection(*(truth[0] + noise[0])), None)
+    belief = kf.reset((PURSUER,), (detection(*(truth[0] + noise[0])),), None)
     errors = []
     for k in range(1, 40):
-        belief = kf.update(DT, PURSUER, detection(*(truth[k] + noise[k])), None)
+        belief = kf.update(DT, (PURSUER,), (detection(*(truth[k] + noise[k])),), None)
         errors.append(math.dist(belief.mean, truth[k]))
     assert max(errors[29:]) < 0.2
     assert belief.covariance.shape == (2, 2)
@@ -436,11 +436,11 @@ def test_kalman_coasts_through_a_gap_of_misses():
     kf = build(KalmanEstimator, grid)
     truth = straight_track(45)
     noise = np.random.default_rng(24).normal(0.0, 0.1, truth.shape)
-    kf.reset(PURSUER, detection(*(truth[0] + noise[0])), None)
+    kf.reset((PURSUER,), (detection(*(truth[0] + noise[0])),), None)
     for k in range(1, 35):
-        tracked = kf.update(DT, PURSUER, detection(*(truth[k] + noise[k])), None)
+        tracked = kf.update(DT, (PURSUER,), (detection(*(truth[k] + noise[k])),), None)
     for _ in range(35, 45):
-        belief = kf.update(DT, PURSUER, None, None)
+        belief = kf.update(DT, (PURSUER,), (None,), None)
     assert math.dist(belief.mean, truth[44]) < 0.2
     assert math.dist(belief.mean, tracked.mean) > 0.3  # it moved along the track
     assert np.trace(belief.covariance) > np.trace(tracked.covariance)
@@ -449,11 +449,11 @@ def test_kalman_coasts_through_a_gap_of_misses():
 def test_kalman_waits_for_a_detection_and_clamps_the_speed():
     grid = room()
     kf = build(KalmanEstimator, grid)
-    assert kf.reset(PURSUER, None, None).mean is None
-    assert kf.update(DT, PURSUER, None, None).mean is None
-    assert kf.update(DT, PURSUER, detection(1.0, 1.0), None).mean == (1.0, 1.0)
+    assert kf.reset((PURSUER,), (None,), None).mean is None
+    assert kf.update(DT, (PURSUER,), (None,), None).mean is None
+    assert kf.update(DT, (PURSUER,), (detection(1.0, 1.0),), None).mean == (1.0, 1.0)
     for k in range(1, 20):  # detections moving at 3 m/s, six times the evader's v_max
-        kf.update(DT, PURSUER, detection(1.0 + 0.3 * k, 1.0), None)
+        kf.update(DT, (PURSUER,), (detection(1.0 + 0.3 * k, 1.0),), None)
         assert math.hypot(*kf._kf.x[2:4]) <= 0.5 + 1e-12
 
 
@@ -463,9 +463,9 @@ def test_kalman_waits_for_a_detection_and_clamps_the_speed():
 def test_last_seen_holds_the_last_detection():
     grid = room()
     estimator = build(LastSeen, grid)
-    assert estimator.reset(PURSUER, None, None).mean is None
+    assert estimator.reset((PURSUER,), (None,), None).mean is None
     for position in straight_track(10):
-        belief = estimator.update(DT, PURSUER, detection(*position), None)
+        belief = estimator.update(DT, (PURSUER,), (detection(*position),), None)
         assert belief.mean == tuple(position)
     for _ in range(5):
-        assert estimator.update(DT, PURSUER, None, None).mean == tuple(position)
+        assert estimator.update(DT, (PURSUER,), (None,), None).mean == tuple(position)

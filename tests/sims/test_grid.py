@@ -56,9 +56,8 @@ def test_free_motion_is_the_exact_unicycle_arc():
 def test_an_agent_stops_at_a_wall_and_can_still_turn():
     grid = walled_room()
     sim = simulator(grid)
-    sim.reset(
-        (Pose(1.0, 1.5, 0.0),), (Pose(3.5, 2.5),)
-    )  # heading at the pillar's left face x = 1.75
+    # heading at the pillar's left face x = 1.75
+    sim.reset((Pose(1.0, 1.5, 0.0),), (Pose(3.5, 2.5),))
     for _ in range(40):
         sim.step((Velocity(0.5, 0.0),), (Velocity(),), DT)
     stopped = sim.poses[0][0]

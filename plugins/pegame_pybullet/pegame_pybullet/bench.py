@@ -177,11 +177,11 @@ def memory_growth(cycles: int = 30, env: str = "enclosed", steps: int = 10) -> d
     def cycle(k: int) -> None:
         sim = cls(config, game.context, rng)
         pursuer, evader = spawn(game.context, np.random.default_rng(k))
-        sim.reset_1v1(pursuer, evader)
+        sim.reset((pursuer,), (evader,))
         try:
             for step in range(steps):
-                sim.sense_1v1(step * game.context.control_dt)
-                sim.step_1v1(ARC, ARC, game.context.control_dt)
+                sim.sense(step * game.context.control_dt)
+                sim.step((ARC,), (ARC,), game.context.control_dt)
         finally:
             sim.close()
 
