@@ -7,12 +7,10 @@
 # $OUT/grid; and paper_conditions' own perception model, into $OUT/grid_plain. Then the
 # held-out check of the profile and compare.py's tables (run3d.sh first).
 set -euo pipefail
-OUT=${OUT:-outputs/fidelity}
-N=${N:-20}
-JOBS=${JOBS:-1}
+# shellcheck source=docs/fidelity/protocol.sh
+source "$(dirname "$0")/protocol.sh"
 PROFILE=${PROFILE:-vision_paper_tilt_160}
-COMMON="+experiment=paper_conditions game.turn_order=simultaneous game.trials=$N"
-COMMON="$COMMON hydra.launcher.n_jobs=$JOBS recorder=none"
+COMMON="$PROTOCOL recorder=none"
 run() {  # run <dir> <overrides...>: the three pairings
   local dir=$1; shift
   # shellcheck disable=SC2086

@@ -10,12 +10,10 @@
 # and the tilt $TILT (default 0: level, where it detects at all), into $OUT/3d_person.
 # PAIRINGS (default "S-S S-R R-R") picks pairings, e.g. for a second process.
 set -euo pipefail
-OUT=${OUT:-outputs/fidelity}
-N=${N:-20}
-JOBS=${JOBS:-1}
+# shellcheck source=docs/fidelity/protocol.sh
+source "$(dirname "$0")/protocol.sh"
 DETECTOR=${DETECTOR:-vision}
-COMMON="+experiment=paper_conditions sim=pybullet detector=$DETECTOR game.turn_order=simultaneous"
-COMMON="$COMMON detector.occlusion_miss=0 game.trials=$N hydra.launcher.n_jobs=$JOBS"
+COMMON="$PROTOCOL sim=pybullet detector=$DETECTOR detector.occlusion_miss=0"
 DIR=$OUT/3d
 if [ "$DETECTOR" = vision ]; then
   COMMON="$COMMON sim.width=160 sim.height=120"

@@ -1,0 +1,9 @@
+# The protocol both sides of the fidelity study play (sourced by run.sh and run3d.sh):
+# +experiment=paper_conditions with simultaneous moves, n = $N games per cell (default 20,
+# seeds 0..N-1, common to both sides), $JOBS jobs at a time (default 1), under $OUT
+# (default outputs/fidelity).
+OUT=${OUT:-outputs/fidelity}
+N=${N:-20}
+JOBS=${JOBS:-1}
+PROTOCOL="+experiment=paper_conditions game.turn_order=simultaneous game.trials=$N"
+PROTOCOL="$PROTOCOL hydra.launcher.n_jobs=$JOBS"
