@@ -28,8 +28,11 @@ return [
 @pytest.mark.slow
 @pytest.mark.skipif(MISSING is not None, reason=f"no headless browser: {MISSING}")
 def test_a_person_at_the_page_moves_the_evader_sees_the_cone_and_gets_the_result(tmp_path):
+    # the presses end 3.8 s after the first frame is drawn; the game runs in real time
+    # whatever the page does, so a loaded machine that draws late needs slack: at
+    # t_max=4.5, one run of the suite at load 9 saw the evader not move at all
     game = browser_game(
-        ["game.t_max=4.5", "pursuer=random", "estimator=last_seen", "recorder=none"],
+        ["game.t_max=9", "pursuer=random", "estimator=last_seen", "recorder=none"],
         tmp_path,
         probe=GAMEPAD_PROBE,
     )
