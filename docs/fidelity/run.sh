@@ -10,20 +10,7 @@ set -euo pipefail
 # shellcheck source=docs/fidelity/protocol.sh
 source "$(dirname "$0")/protocol.sh"
 PROFILE=${PROFILE:-vision_paper_tilt_160}
-COMMON="$PROTOCOL recorder=none"
-run() {  # run <dir> <overrides...>: the three pairings
-  local dir=$1; shift
-  # shellcheck disable=SC2086
-  python -m pegame -m $COMMON "$@" pursuer=smart pursuer.detour=false evader=smart \
-    evader.hide_margin=0 hydra.sweep.dir="$OUT/$dir/S-S" resume=true
-  # shellcheck disable=SC2086
-  python -m pegame -m $COMMON "$@" pursuer=smart pursuer.detour=false evader=random \
-    evader.model=action hydra.sweep.dir="$OUT/$dir/S-R" resume=true
-  # shellcheck disable=SC2086
-  python -m pegame -m $COMMON "$@" pursuer=random pursuer.model=action evader=random \
-    evader.model=action hydra.sweep.dir="$OUT/$dir/R-R" resume=true
-}
-run grid detector.occlusion_miss=0 detector.profile="$PROFILE"
-run grid_plain
+grid grid detector.occlusion_miss=0 detector.profile="$PROFILE"
+grid grid_plain
 python docs/fidelity/heldout.py
 python docs/fidelity/compare.py "$OUT"
