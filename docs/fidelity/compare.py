@@ -52,6 +52,11 @@ TABLES = {
     "3d_person": "3d_person",
     "grid_person": "grid_person",
 }
+#: the 3D tables as the pages name them
+THREE_D_NAMES = {
+    "3d_pipeline": "the 3D pipeline",
+    "3d_person": "the 3D pipeline with detector=person",
+}
 #: (page, grid table, 3D table) of each grid-against-3D comparison
 COMPARISONS = (
     ("grid_vs_3d", "grid_profile", "3d_pipeline"),
@@ -170,7 +175,8 @@ def main(argv: list[str]) -> int:
         rows = compare(rates[title], rates[three_d])
         if not rows:  # not played yet
             continue
-        text, csv_text = render(rows, f"The grid ({title}) against {three_d}", SCRIPT)
+        against = THREE_D_NAMES[three_d]
+        text, csv_text = render(rows, f"The grid ({title}) against {against}", SCRIPT)
         write_atomic(HERE / f"{name}.md", text)
         write_atomic(HERE / f"{name}.csv", csv_text)
         gaps = [abs(r["mean_difference"]) for r in rows]
