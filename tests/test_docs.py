@@ -53,6 +53,17 @@ def test_the_results_pages_tables_are_those_generated_from_the_committed_tables(
     assert done.returncode == 0, done.stderr
 
 
+def test_the_vmas_page_and_readme_table_are_those_generated_from_the_committed_csv():
+    # the side-by-side's render from docs/performance/vmas.csv (no VMAS needed to check)
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "docs" / "performance" / "vmas_side_by_side.py"), "--check"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+
+
 def test_the_performance_history_page_is_generated_from_its_records():
     done = subprocess.run(
         [sys.executable, str(ROOT / "docs" / "performance" / "history.py"), "--check"],
