@@ -409,9 +409,7 @@ class TickLoop:
             self._integrate(pursuers=p_cmds)
             self._next_tick()
         else:
-            sim, dt = self.sim, self.context.control_dt / self.substeps
-            for _ in range(self.substeps):
-                sim.step(p_cmds, e_cmds, dt)
+            self._integrate(p_cmds, e_cmds)
             self._next_tick()
             self._sense()  # also after the last tick: the environments observe the final state
         return tick

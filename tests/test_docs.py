@@ -43,35 +43,27 @@ def test_the_site_builds_strictly_offline(tmp_path):
     assert reference.count("Parameters:") >= 10  # the interfaces' parameter sections
 
 
-def test_the_results_pages_tables_are_those_generated_from_the_committed_tables():
+def check(script: str) -> None:
+    """``python docs/<script> --check`` exits 0: the pages it generates are up to date."""
     done = subprocess.run(
-        [sys.executable, str(ROOT / "docs" / "results" / "tables.py"), "--check"],
+        [sys.executable, str(ROOT / "docs" / script), "--check"],
         capture_output=True,
         text=True,
         timeout=60,
     )
     assert done.returncode == 0, done.stderr
+
+
+def test_the_results_pages_tables_are_those_generated_from_the_committed_tables():
+    check("results/tables.py")
 
 
 def test_the_vmas_page_and_readme_table_are_those_generated_from_the_committed_csv():
-    # the side-by-side's render from docs/performance/vmas.csv (no VMAS needed to check)
-    done = subprocess.run(
-        [sys.executable, str(ROOT / "docs" / "performance" / "vmas_side_by_side.py"), "--check"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert done.returncode == 0, done.stderr
+    check("performance/vmas_side_by_side.py")  # rendered from vmas.csv: no VMAS needed
 
 
 def test_the_performance_history_page_is_generated_from_its_records():
-    done = subprocess.run(
-        [sys.executable, str(ROOT / "docs" / "performance" / "history.py"), "--check"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert done.returncode == 0, done.stderr
+    check("performance/history.py")
     page = (ROOT / "docs" / "explanation" / "performance-history.md").read_text()
     records = (ROOT / "docs" / "performance" / "history.jsonl").read_text().splitlines()
     assert records  # a row per record, named by its commit

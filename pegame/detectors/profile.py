@@ -72,12 +72,12 @@ ERRORS = ("error_along_mean_m", "error_along_std_m", "error_across_std_m")
 
 
 def profiles_dir() -> Path | None:
-    """pegame-vision's committed profiles (``profiles/<camera>/<detector>.csv`` beside its
-    package), or None when it is not installed from a checkout."""
+    """pegame-vision's committed profiles (``profiles/<camera>/<detector>.csv`` in its
+    package, installed with it), or None when pegame-vision is not installed."""
     spec = importlib.util.find_spec("pegame_vision")
     if spec is None or spec.origin is None:
         return None
-    folder = Path(spec.origin).resolve().parent.parent / "profiles"
+    folder = Path(spec.origin).resolve().parent / "profiles"
     return folder if folder.is_dir() else None
 
 
