@@ -119,12 +119,13 @@ def game_seconds(overrides: list[str], out_dir: str) -> float:
 
 
 def game_times(overrides: list[str], out_dir: str) -> tuple[float, float]:
-    """(wall-clock time, CPU time of the playing thread) (s) of playing one game (not
-    building it). The CPU time leaves out what other processes take of the machine."""
+    """(wall-clock time, CPU time of this process) (s) of playing one game (not building
+    it). The CPU time leaves out what other processes take of the machine and counts
+    every thread of this one (rerun-sdk's own threads take a few ms of a recorded game)."""
     game = Game(compose(overrides))
-    start, cpu = time.perf_counter(), time.thread_time()
+    start, cpu = time.perf_counter(), time.process_time()
     game.play(out_dir)
-    return time.perf_counter() - start, time.thread_time() - cpu
+    return time.perf_counter() - start, time.process_time() - cpu
 
 
 def games_per_second(overrides: list[str], games: int, out_dir: str) -> float:
@@ -213,12 +214,12 @@ def bench_decisions(
 def recorder_cost(games: int, out_dir: str) -> dict[str, float | None]:
     """The cost of recording an S-S game with recorder=rerun: ``recorder_overhead``, its
     fractional extra wall-clock time, ``recorder_cpu_overhead``, the same in CPU time of
-    the playing thread, and ``rrd_mb_per_game``, the largest .rrd (MB).
+    the process, and ``rrd_mb_per_game``, the largest .rrd (MB).
 
     Each seed is played without and then with the recorder, one right after the other,
     and the figures are medians of the per-seed ratios: on a shared machine, neighbouring
-    games see the same load. The CPU time (rerun-sdk encodes the recording on that
-    thread when the game ends) varies less with the load than the wall-clock time."""
+    games see the same load. The CPU time varies less with the load than the wall-clock
+    time."""
     figures: dict[str, float | None] = dict.fromkeys(
         ("recorder_overhead", "recorder_cpu_overhead", "rrd_mb_per_game")
     )
@@ -230,17 +231,30 @@ def recorder_cost(games: int, out_dir: str) -> dict[str, float | None]:
     )  # imports rerun-sdk, compiles the outline kernel
     walls, cpus = [], []
     for seed in range(games):
+        # Each game writes into a directory of its own, as a sweep's games write files of
+        # their own: replacing an earlier game's 2 MB recording frees its blocks, which
+        # cost 1 ms more than the write itself here (ext4 with discard).
         plain, recorded = (
-            game_times([*base, f"recorder={recorder}", f"game.seed={seed}"], out_dir)
+            game_times(
+                [*base, f"recorder={recorder}", f"game.seed={seed}"],
+                _new_dir(out_dir, f"recorder_{recorder}_{seed}"),
+            )
             for recorder in ("none", "rerun")
         )
         walls.append(recorded[0] / plain[0] - 1.0)
         cpus.append(recorded[1] / plain[1] - 1.0)
-    sizes = [p.stat().st_size for p in Path(out_dir).glob("*.rrd")]
+    sizes = [p.stat().st_size for p in Path(out_dir).glob("recorder_rerun_*/*.rrd")]
     figures["recorder_overhead"] = statistics.median(walls)
     figures["recorder_cpu_overhead"] = statistics.median(cpus)
     figures["rrd_mb_per_game"] = max(sizes) / 2**20 if sizes else None
     return figures
+
+
+def _new_dir(parent: str, name: str) -> str:
+    """``parent/name``, created empty."""
+    path = Path(parent) / name
+    path.mkdir()
+    return str(path)
 
 
 class _NoLosses(LossCauses):
@@ -487,7 +501,7 @@ def format_report(report: dict[str, Any]) -> str:
     overhead, cpu = report["recorder_overhead"], report.get("recorder_cpu_overhead")
     lines.append(
         f"recorder: +{fmt(None if overhead is None else 100 * overhead)}% game time "
-        f"(+{fmt(None if cpu is None else 100 * cpu)}% CPU of the game's thread), "
+        f"(+{fmt(None if cpu is None else 100 * cpu)}% CPU time), "
         f"{fmt(report['rrd_mb_per_game'])} MB per 90 s game"
     )
     losses = report.get("loss_causes_overhead") or {}

@@ -301,7 +301,8 @@ EMPTY_BELIEF = Belief(mean=None)
 class Plan:
     """A strategy's decision: a goal (x, y) in the map frame (m) or None, the path to it as
     (K, 2) waypoints in metres (empty when there is none), and free-form ``info`` that the
-    recorder shows (for example the smart evader's candidate set)."""
+    recorder shows (for example the smart evader's candidate set). A plan is not changed
+    once returned: recorders keep it by reference until they send it."""
 
     goal: tuple[float, float] | None = None
     path: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))

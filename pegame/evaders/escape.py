@@ -59,7 +59,7 @@ DISTANCES = ("euclidean", "geodesic")
 
 #: most candidate points put into Plan.info["candidates"] for the recorder (an evenly
 #: strided subsample: enough to show the set, few enough not to hide the map)
-MAX_RECORDED_CANDIDATES = 500
+MAX_RECORDED_CANDIDATES = 250
 #: edge (cells) of the square tiles that the fast argmin search scores or skips as a whole
 TILE = 8
 #: tiles sorted by bound before the search starts (see EscapeSearch.escape); more than

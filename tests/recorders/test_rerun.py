@@ -396,8 +396,9 @@ def test_recorder_logs_particles_candidates_n_eff_and_events(tmp_path):
     recorder.finish({"tracking_rate": 0.8, "mean_estimation_error": None})
     steps, static, _ = read_steps(tmp_path / "game_7.rrd")
     every = list(range(23))
+    # the particles every particles_every (2) ticks; the viewer holds the last cloud
+    assert steps["/world/belief/particles"] == list(range(0, 23, 2))
     for entity in (
-        "/world/belief/particles",
         "/plots/n_eff",
         "/plots/distance/estimate_error",
         "/world/detection",
@@ -476,7 +477,8 @@ def test_particles_of_equal_weight_are_sent_with_one_colour(tmp_path):
     from rerun.chunk import RrdReader
 
     context = small_context()
-    recorder = RerunRecorder(RerunRecorder.Config(max_particles=100), context, None)
+    config = RerunRecorder.Config(max_particles=100, particles_every=1)
+    recorder = RerunRecorder(config, context, None)
     recorder.start(str(tmp_path), "game", {})
     weighted, resampled = synthetic_ticks(context, 2)
     n = len(resampled.belief.particles)

@@ -38,7 +38,8 @@ world/evader/...           pose, heading, trajectory, path and goal (the chosen
 world/evader/candidates    Points3D, ``plan.info["candidates"]``        new plans
 world/detection            Points3D, the detection's map position       every tick
 world/belief/mean          Points3D, the estimate                       every tick
-world/belief/particles     Points3D coloured by weight, a strided subsample
+world/belief/particles     Points3D coloured by weight, a strided subsample,
+                           every ``particles_every`` ticks
 camera/frame               LineStrips2D, the image border (static)
 camera/image               JPEG of ``frame.rgb`` every ``image_every`` ticks, if any
 camera/detection           Boxes2D, the detection's bounding box (px)   every tick

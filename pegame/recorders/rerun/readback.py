@@ -46,8 +46,9 @@ class RecordedGame:
     estimate_error, n_eff: (T,) series of the recording's plots (NaN where a tick has no
     value, such as the estimation error while the evader is seen). outlines: per tick the
     pursuer 0 visibility outline's (K, 2) polygons. particles: per tick the (P, 2)
-    particle subsample about evader 0, means: (T, 2) its belief mean. config: the game's
-    flat config properties (``camera.fov``, ``pursuer.radius``, ...).
+    particle subsample about evader 0 last logged (every ``particles_every`` ticks),
+    means: (T, 2) its belief mean. config: the game's flat config properties
+    (``camera.fov``, ``pursuer.radius``, ...).
     """
 
     grid: OccupancyGrid
@@ -153,13 +154,20 @@ def read_game(path: str | Path) -> RecordedGame:
         ]
         if "/world/pursuer/visible" in rows
         else [[] for _ in steps],
-        particles=[
-            np.asarray(
-                rows.get("/world/belief/particles", {}).get(s) or np.empty((0, 3)), dtype=float
-            )[:, :2]
-            for s in steps
-        ],
+        particles=_latest(rows.get("/world/belief/particles", {}), steps),
     )
+
+
+def _latest(values: dict[int, Any], steps: np.ndarray) -> list[np.ndarray]:
+    """Per step, the (P, 2) points of the latest row at or before it, as the viewer
+    shows them (the particles are logged every ``particles_every`` ticks); (0, 2) before
+    the first row and after an empty one."""
+    out, last = [], np.empty((0, 2))
+    for step in steps.tolist():
+        if step in values:
+            last = np.asarray(values[step] or np.empty((0, 3)), dtype=float)[:, :2]
+        out.append(last)
+    return out
 
 
 def _series(values: dict[int, Any], steps: np.ndarray) -> np.ndarray:

@@ -45,6 +45,7 @@ import rerun as rr
 from pegame.api import Context, Recorder, Tick
 from pegame.errors import ResultsWriteError, require
 from pegame.files import make_dir, write_atomic
+from pegame.grid import per_grid
 from pegame.recorders.files import COMPLETE, FAILED, PARTIAL, recording_path
 from pegame.recorders.rerun.blueprint import blueprint
 from pegame.recorders.rerun.columns import ParticleRows, row_columns, tick_row, time_index
@@ -57,9 +58,9 @@ from pegame.recorders.rerun.properties import (
 from pegame.recorders.rerun.scene import (
     Z_PARTICLES,
     Buffers,
+    PlanRows,
     buffer_event,
     buffer_losses,
-    buffer_plan,
     log_agents,
     log_image,
     log_particles,
@@ -89,14 +90,19 @@ class RerunRecorder(Recorder):
         )
         flush_every: int = 1000  # control ticks buffered per send (sends cost a fixed time each; a 90 s game is one)
         live_flush_every: int = 10  # the same with spawn=true, so that the live viewer keeps up
-        max_particles: int = 100  # particles logged per tick, an evenly strided subsample (0: none)
+        max_particles: int = (
+            100  # particles logged per logged tick, an evenly strided subsample (0: none)
+        )
+        particles_every: int = (
+            2  # control ticks between logged particle clouds (the viewer holds the last)
+        )
         trail_every: int = 5  # control ticks between trajectory points
-        outline_rays: int = 64  # rays cast on the grid to draw the visibility region's outline
+        outline_rays: int = 48  # rays cast on the grid to draw the visibility region's outline
         image_every: int = 10  # control ticks between logged camera images (0: none)
         jpeg_quality: int = 80  # JPEG quality (1-100) of the logged camera images
 
         def __post_init__(self) -> None:
-            for key in ("flush_every", "live_flush_every", "trail_every"):
+            for key in ("flush_every", "live_flush_every", "trail_every", "particles_every"):
                 require(
                     getattr(self, key) >= 1,
                     key,
@@ -134,7 +140,8 @@ class RerunRecorder(Recorder):
         self._particles = ParticleRows(self._flush_every, config.max_particles, Z_PARTICLES)
         self._buffers = Buffers()
         self._trail_ends: dict[str, np.ndarray] = {}  # per agent, the last trajectory point (1, 3)
-        self._plans: list = [None, None]
+        self._plans: list = [None, None]  # the latest (pursuer, evader) plans
+        self._plan_rows = (PlanRows("pursuer"), PlanRows("evader"))
         self._modes: dict[str, Any] = {"pursuer": None, "evader": None}
         self._detected: bool | None = None
         self._changed_at = 0.0
@@ -272,16 +279,21 @@ class RerunRecorder(Recorder):
         assert rec is not None  # log returns early without a recording
         if self._last is None:
             has_image = tick.frame.rgb is not None
-            rec.send_blueprint(blueprint(self.context.grid, self.context.camera, has_image))
+            layout = per_grid(
+                self.context.grid,
+                ("recorders.rerun", "blueprint", self.context.camera, has_image),
+                lambda grid: blueprint(grid, self.context.camera, has_image),
+            )
+            rec.send_blueprint(layout)
         self._last = tick
-        self._detections += tick.detection is not None
-        self._rows.append(tick_row(tick, self._detections / (tick.step + 1)))
-        if self.config.max_particles:
+        self._rows.append(tick_row(tick))
+        particles = self.config.max_particles if tick.step % self.config.particles_every == 0 else 0
+        if particles:
             self._particles.add(tick.step, tick.time, tick.belief.particles, tick.belief.weights)
         self._log_plans(tick)
         self._log_detection_events(tick)
         buffer_losses(self._buffers, tick)
-        buffer_team(self._buffers, tick, self.context, self.config.max_particles)
+        buffer_team(self._buffers, tick, self.context, particles)
         every = self.config.image_every
         if tick.frame.rgb is not None and every and tick.step % every == 0:
             log_image(rec, tick, self.context.camera, self.config.jpeg_quality)
@@ -296,7 +308,7 @@ class RerunRecorder(Recorder):
             if plan is self._plans[index]:
                 continue
             self._plans[index] = plan
-            buffer_plan(self._buffers, name, plan, tick)
+            self._plan_rows[index].add(tick.step, tick.time, plan)
             mode = plan.info.get("mode")
             if mode is not None and mode != self._modes[name]:
                 self._modes[name] = mode
@@ -332,8 +344,9 @@ class RerunRecorder(Recorder):
         rec, indexes = self._rec, dict[bytes, list]()
         assert rec is not None  # flushed only while recording
         if self._rows:
-            c = row_columns(self._rows)
+            c = row_columns(self._rows, self._detections)
             self._rows = []
+            self._detections += int(np.isfinite(c["det_x"]).sum())
             steps, times = c["step"].astype(np.int64), c["time"]
             every = time_index(indexes, steps, times)
             log_agents(rec, c, every, self.context, self.config.outline_rays)
@@ -341,4 +354,6 @@ class RerunRecorder(Recorder):
             log_plots(rec, c, every, lambda given: time_index(indexes, steps[given], times[given]))
             log_trails(rec, c, indexes, self.config.trail_every, final, self._trail_ends)
         log_particles(rec, self._particles, indexes)
+        for plans in self._plan_rows:
+            plans.send(rec, indexes)
         self._buffers.send(rec, indexes)

@@ -4,8 +4,8 @@ As in Rerun's nuScenes example, each entity tree has one ``log_<family>()``: the
 once per recording (:func:`log_static`: map, camera border, FOV wedge, config document,
 styles), the buffered ticks at each send (:func:`log_agents`, :func:`log_trails`,
 :func:`log_sensing`, :func:`log_plots`, :func:`log_particles`, with columns from
-:mod:`.columns`), and the rare rows as they happen (:func:`buffer_plan`,
-:func:`buffer_event`, :func:`log_image`). The entity paths are listed in
+:mod:`.columns`), and the rare rows: new plans (:class:`PlanRows`), events
+(:func:`buffer_event`) and images (:func:`log_image`, logged as they happen). The entity paths are listed in
 :mod:`pegame.recorders.rerun`. Positions are in the map frame (m); the heights Z_* (m)
 lift the overlays above the map so that nothing z-fights.
 """
@@ -306,25 +306,74 @@ class Buffers(dict):
             buffer.send(rec, indexes)
 
 
-def buffer_plan(buffers: Buffers, name: str, plan: Plan, tick: Tick) -> None:
-    """Agent ``name``'s new plan: its path, its goal and the candidates it chose from."""
-    path = np.asarray(plan.path, dtype=float).reshape(-1, 2)
-    strips = [points_at(path, Z_PLAN)] if len(path) >= 2 else []
-    buffers.add(f"world/{name}/path", rr.LineStrips3D, tick.step, tick.time, strips=strips)
-    goal = [plan.goal] if plan.goal is not None else []
-    buffers.add(
-        f"world/{name}/goal", rr.Points3D, tick.step, tick.time, positions=points_at(goal, Z_PLAN)
-    )
-    candidates = plan.info.get("candidates")
-    candidates = points_at(np.zeros((0, 2)) if candidates is None else candidates, Z_PLAN)
-    buffers.add(
-        f"world/{name}/candidates",
-        rr.Points3D,
-        tick.step,
-        tick.time,
-        create=len(candidates) > 0,
-        positions=candidates,
-    )
+class PlanRows:
+    """Agent ``name``'s new plans since the last send, kept by reference (a plan is not
+    changed once returned, :class:`pegame.types.Plan`) and sent as rows of its path, its
+    goal and the candidates it chose from: converting them together at the send costs
+    less than converting each between the game's ticks."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.steps: list[int] = []
+        self.times: list[float] = []
+        self.plans: list[Plan] = []
+        self.has_candidates = False  # the candidates entity exists (an empty row clears it)
+
+    def add(self, step: int, time: float, plan: Plan) -> None:
+        self.steps.append(step)
+        self.times.append(time)
+        self.plans.append(plan)
+
+    def send(self, rec: rr.RecordingStream, indexes: dict) -> None:
+        """Send the buffered plans' rows and empty the buffer (``indexes``: see
+        :func:`.columns.time_index`)."""
+        if not self.plans:
+            return
+        steps, times, plans = (
+            np.asarray(self.steps, dtype=np.int64),
+            np.asarray(self.times),
+            self.plans,
+        )
+        self.steps, self.times, self.plans = [], [], []
+        paths = [np.asarray(plan.path, dtype=float).reshape(-1, 2) for plan in plans]
+        drawn = [path for path in paths if len(path) >= 2]
+        strips = strips_array([points_at(path, Z_PLAN) for path in drawn])
+        index = time_index(indexes, steps, times)
+        sizes = np.array([len(path) >= 2 for path in paths], dtype=np.int64)
+        _send(
+            rec,
+            f"world/{self.name}/path",
+            index,
+            rr.LineStrips3D.columns(strips=strips).partition(sizes),
+        )
+        goals = [plan.goal for plan in plans if plan.goal is not None]
+        sizes = np.array([plan.goal is not None for plan in plans], dtype=np.int64)
+        columns = rr.Points3D.columns(positions=points_at(goals, Z_PLAN)).partition(sizes)
+        _send(rec, f"world/{self.name}/goal", index, columns)
+        found = [plan.info.get("candidates") for plan in plans]
+        counts = np.array([0 if c is None else len(c) for c in found], dtype=np.int64)
+        first = (
+            0
+            if self.has_candidates
+            else int(np.argmax(counts > 0))
+            if counts.any()
+            else len(counts)
+        )
+        if first == len(counts):
+            return
+        self.has_candidates = True
+        candidates = _flat_points([c for c in found[first:] if c is not None and len(c)], Z_PLAN)
+        columns = rr.Points3D.columns(positions=candidates).partition(counts[first:])
+        index = time_index(indexes, steps[first:], times[first:])
+        _send(rec, f"world/{self.name}/candidates", index, columns)
+
+
+def _flat_points(parts: list[np.ndarray], z: float) -> np.ndarray:
+    """The (K_i, >= 2) map-frame positions (m) of ``parts``, one after the other, as
+    (sum K_i, 3) float32 points at height z."""
+    if not parts:
+        return np.zeros((0, 3), dtype=np.float32)
+    return points_at(np.concatenate([np.asarray(part, dtype=float)[:, :2] for part in parts]), z)
 
 
 def buffer_event(buffers: Buffers, step: int, time: float, text: str, level: str = "INFO") -> None:

@@ -54,7 +54,8 @@ def _discs(positions: ArrayLike, radius: float, color: ArrayLike) -> dict[str, A
 
 
 def buffer_team(buffers: Buffers, tick: Tick, context: Context, max_particles: int) -> None:
-    """Buffer the tick's team members past member 0 (module docstring); nothing in 1v1."""
+    """Buffer the tick's team members past member 0 (module docstring), with at most
+    ``max_particles`` particles per belief (0: none this tick); nothing in 1v1."""
     team = tick.team
     if team is None or (len(team.pursuers) == 1 and len(team.evaders) == 1):
         return
