@@ -75,7 +75,6 @@ __all__ = [
     "OneOnOneSimulator",
     "Simulator",
     "Strategy",
-    "TeamTick",
     "Tick",
     "Velocity",
     "clamp",
@@ -168,57 +167,119 @@ class Context:
 
 @value_type(eq=False)
 class Tick:
-    """Everything that happened at one control tick, as the recorder receives it.
+    """Everything that happened at one control tick of a game of N pursuers and M evaders
+    (1v1: N = M = 1), as the recorder receives it; every field is per member, in member
+    order, and the properties below give member 0's for a 1v1 recorder.
 
-    step: control tick index; time (s); pursuer, evader: true poses; frame: the sensor
-    frame; detection or None; belief; region: the pursuer's visibility region (None when not computed);
-    in_view: ground-truth visibility of the evader; commands: (pursuer, evader) velocities
-    applied after this tick (with ``game.turn_order=evader_first`` the evader's was applied
-    just before it, see :mod:`pegame.loop`); plans: the latest (pursuer, evader) plans;
-    team: every member's part in a team game; losses: the losses of track begun at this
-    tick, every pair's, each with its cause (:mod:`pegame.losses`).
+    step: control tick index; time (s); pursuers (N) and evaders (M): true poses; frames:
+    each pursuer's sensor frame; detections[i][j]: pursuer i's detection of evader j or
+    None; beliefs: one per evader; regions: each pursuer's visibility region (None when not
+    computed); in_views[i][j]: ground truth, evader j's body in pursuer i's view;
+    pursuer_commands, evader_commands: the velocities applied after this tick (with
+    ``game.turn_order=evader_first`` the evaders' were applied just before it, see
+    :mod:`pegame.loop`); pursuer_plans, evader_plans: the latest plans; losses: the losses
+    of track begun at this tick, every pair's, each with its cause (:mod:`pegame.losses`).
     """
 
     step: int
     time: float
-    pursuer: Pose
-    evader: Pose
-    frame: SensorFrame
-    detection: Detection | None
-    belief: Belief
-    region: Region | None
-    in_view: bool
-    commands: tuple[Velocity, Velocity]
-    plans: tuple[Plan, Plan]
-    team: TeamTick | None = None
-    losses: tuple[Loss, ...] = ()
-
-
-@value_type(eq=False)
-class TeamTick:
-    """Every member's part of one control tick (the :class:`Tick`'s own fields are
-    pursuer 0's and evader 0's: its detection and belief of evader 0, and in_view whether
-    any pursuer has evader 0 in view).
-
-    pursuers (N) and evaders (M): true poses; frames: each pursuer's sensor frame;
-    detections[i][j]: pursuer i's detection of evader j or None; beliefs: one per evader;
-    regions: each pursuer's visibility region (None when not computed); in_view[i][j]:
-    ground truth, evader j's body in pursuer i's view; pursuer_commands,
-    evader_commands: the velocities applied after this tick; pursuer_plans,
-    evader_plans: the latest plans. (A 1v1 game's ticks have ``team`` None.)
-    """
-
     pursuers: tuple[Pose, ...]
     evaders: tuple[Pose, ...]
     frames: tuple[SensorFrame, ...]
     detections: tuple[tuple[Detection | None, ...], ...]
     beliefs: tuple[Belief, ...]
     regions: tuple[Region | None, ...]
-    in_view: tuple[tuple[bool, ...], ...]
+    in_views: tuple[tuple[bool, ...], ...]
     pursuer_commands: tuple[Velocity, ...]
     evader_commands: tuple[Velocity, ...]
     pursuer_plans: tuple[Plan, ...]
     evader_plans: tuple[Plan, ...]
+    losses: tuple[Loss, ...] = ()
+
+    @classmethod
+    def one_on_one(
+        cls,
+        step: int,
+        time: float,
+        pursuer: Pose,
+        evader: Pose,
+        frame: SensorFrame,
+        detection: Detection | None,
+        belief: Belief,
+        region: Region | None,
+        in_view: bool,
+        commands: tuple[Velocity, Velocity],
+        plans: tuple[Plan, Plan],
+        losses: tuple[Loss, ...] = (),
+    ) -> Tick:
+        """The tick of a 1v1 game from its members' values (commands and plans as
+        (pursuer, evader) pairs)."""
+        return cls(
+            step,
+            time,
+            (pursuer,),
+            (evader,),
+            (frame,),
+            ((detection,),),
+            (belief,),
+            (region,),
+            ((in_view,),),
+            (commands[0],),
+            (commands[1],),
+            (plans[0],),
+            (plans[1],),
+            losses,
+        )
+
+    @property
+    def pursuer(self) -> Pose:
+        """Pursuer 0's true pose."""
+        return self.pursuers[0]
+
+    @property
+    def evader(self) -> Pose:
+        """Evader 0's true pose."""
+        return self.evaders[0]
+
+    @property
+    def frame(self) -> SensorFrame:
+        """Pursuer 0's sensor frame."""
+        return self.frames[0]
+
+    @property
+    def detection(self) -> Detection | None:
+        """Pursuer 0's detection of evader 0, or None."""
+        return self.detections[0][0]
+
+    @property
+    def belief(self) -> Belief:
+        """The belief about evader 0."""
+        return self.beliefs[0]
+
+    @property
+    def region(self) -> Region | None:
+        """Pursuer 0's visibility region (None when not computed)."""
+        return self.regions[0]
+
+    @property
+    def in_view(self) -> bool:
+        """Whether any pursuer has evader 0's body in view (ground truth)."""
+        return any(row[0] for row in self.in_views)
+
+    @property
+    def commands(self) -> tuple[Velocity, Velocity]:
+        """(pursuer 0's, evader 0's) velocities applied after this tick."""
+        return self.pursuer_commands[0], self.evader_commands[0]
+
+    @property
+    def plans(self) -> tuple[Plan, Plan]:
+        """(pursuer 0's, evader 0's) latest plans."""
+        return self.pursuer_plans[0], self.evader_plans[0]
+
+    @property
+    def solo(self) -> bool:
+        """Whether this is a 1v1 game's tick (N = M = 1)."""
+        return len(self.pursuers) == 1 and len(self.evaders) == 1
 
 
 # ----------------------------------------------------------------------- interfaces

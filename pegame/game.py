@@ -222,23 +222,6 @@ TRAJECTORY_HEADER = (
 )
 
 
-def trajectory_row(t: Tick) -> tuple:
-    """A 1v1 tick as a row of :data:`TRAJECTORY_HEADER`."""
-    p, e = t.pursuer, t.evader
-    return (
-        t.step,
-        round(t.time, 6),
-        p.x,
-        p.y,
-        p.theta,
-        e.x,
-        e.y,
-        e.theta,
-        int(t.detection is not None),
-        int(t.in_view),
-    )
-
-
 def team_header(pursuers: int, evaders: int) -> tuple[str, ...]:
     """The trajectory columns of a team game: step, time, every pursuer's pose
     (``pursuer_<i>_x`` ...), every evader's, then per evader whether some pursuer
@@ -253,17 +236,23 @@ def team_header(pursuers: int, evaders: int) -> tuple[str, ...]:
     return ("step", "time", *poses, *flags)
 
 
-def team_trajectory_row(t: Tick) -> tuple:
-    """A team tick as a row of :func:`team_header`."""
-    team = t.team
-    if team is None:
-        raise ValueError("A 1v1 tick has no team row: use trajectory_row.")
-    poses = [v for pose in (*team.pursuers, *team.evaders) for v in (pose.x, pose.y, pose.theta)]
-    flags = []
-    for j in range(len(team.evaders)):
-        flags.append(int(any(row[j] is not None for row in team.detections)))
-        flags.append(int(any(row[j] for row in team.in_view)))
-    return (t.step, round(t.time, 6), *poses, *flags)
+def trajectory_row(t: Tick) -> tuple:
+    """A tick as a row of :func:`team_header` (a 1v1 game's as a row of
+    :data:`TRAJECTORY_HEADER`, the same columns under their 1v1 names). (Loops, not
+    comprehensions: this runs every tick.)"""
+    row: list = [t.step, round(t.time, 6)]
+    for pose in t.pursuers:
+        row += (pose.x, pose.y, pose.theta)
+    for pose in t.evaders:
+        row += (pose.x, pose.y, pose.theta)
+    detections, in_views = t.detections, t.in_views
+    for j in range(len(t.evaders)):
+        detected = seen = 0
+        for i in range(len(detections)):
+            detected |= detections[i][j] is not None
+            seen |= in_views[i][j]
+        row += (int(detected), int(seen))
+    return tuple(row)
 
 
 def check_room_for_team(context: Context, pursuers: int, evaders: int) -> None:
@@ -486,10 +475,9 @@ class Game:
             loop = self.start()
             recorder.start(str(out_dir), recording_name, config)
             trajectory: list[tuple] = []
-            row = trajectory_row if solo else team_trajectory_row
             try:
                 for _ in range(loop.ticks - loop.step):
-                    trajectory.append(row(loop.advance()))
+                    trajectory.append(trajectory_row(loop.advance()))
                 result = self._result(loop.metrics)
             except BaseException as error:
                 recorder.abort(error)

@@ -71,7 +71,6 @@ from pegame.api import (
     PursuerTeam,
     Recorder,
     Simulator,
-    TeamTick,
     Tick,
 )
 from pegame.config import TURN_ORDERS
@@ -218,8 +217,8 @@ class TickLoop:
         self.step = 0
         self.time = 0.0  # s, simulation time of the current tick: step * control_dt
         self.evader_first = turn_order == "evader_first"
-        self.pursuer_plans = [Plan()] * self.n_pursuers
-        self.evader_plans = [Plan()] * self.n_evaders
+        self.pursuer_plans: tuple[Plan, ...] = (Plan(),) * self.n_pursuers
+        self.evader_plans: tuple[Plan, ...] = (Plan(),) * self.n_evaders
         # per-tick constants of the member loops
         self._pursuer_ids, self._evader_ids = range(self.n_pursuers), range(self.n_evaders)
         self._no_regions: tuple[None, ...] = (None,) * self.n_pursuers
@@ -391,9 +390,9 @@ class TickLoop:
                 p_obs.append(self.pursuer_observation(i))
         if deciding:  # the evaders first, then the pursuers (paper)
             if e_obs is not None:
-                self.evader_plans = [s.decide(o) for s, o in zip(evaders, e_obs)]
+                self.evader_plans = tuple([s.decide(o) for s, o in zip(evaders, e_obs)])
             if p_obs is not None:
-                self.pursuer_plans = [s.decide(o) for s, o in zip(pursuers, p_obs)]
+                self.pursuer_plans = tuple([s.decide(o) for s, o in zip(pursuers, p_obs)])
         if p_obs is not None:
             controlled = commanded["pursuer"] = []
             for pursuer, p_ob in zip(pursuers, p_obs):
@@ -427,7 +426,7 @@ class TickLoop:
         self.union = regions[0] if self.n_pursuers == 1 else UnionRegion(regions)
         observations = [self.evader_observation(j) for j in self._evader_ids]
         if deciding:
-            self.evader_plans = [s.decide(o) for s, o in zip(evaders, observations)]
+            self.evader_plans = tuple([s.decide(o) for s, o in zip(evaders, observations)])
         commanded["evader"] = [s.control(o) for s, o in zip(evaders, observations)]
         self._integrate(evaders=commanded["evader"])
         self._sense(regions)
@@ -441,9 +440,7 @@ class TickLoop:
             in_view, detected = self.in_views[0][0], detections[0][0] is not None
             self.tracking.add(pursuers[0], evaders[0], detected, in_view, self.beliefs[0])
             losses = self.losses.add_one(pursuers[0], evaders[0], detected, p_cmds[0])
-            team = None
         else:
-            in_view = self.in_view
             self.team_metrics.add(
                 pursuers,
                 evaders,
@@ -453,32 +450,20 @@ class TickLoop:
                 self.union if deciding else None,
             )
             losses = self.losses.add(pursuers, evaders, detections, p_cmds)
-            team = TeamTick(
-                pursuers,
-                evaders,
-                self.frames,
-                detections,
-                self.beliefs,
-                self.regions,
-                self.in_views,
-                tuple(p_cmds),
-                tuple(e_cmds),
-                tuple(self.pursuer_plans),
-                tuple(self.evader_plans),
-            )
         return Tick(
             self.step,
             self.time,
-            pursuers[0],
-            evaders[0],
-            self.frames[0],
-            detections[0][0],
-            self.beliefs[0],
-            self.regions[0],
-            in_view,
-            (p_cmds[0], e_cmds[0]),
-            (self.pursuer_plans[0], self.evader_plans[0]),
-            team,
+            pursuers,
+            evaders,
+            self.frames,
+            detections,
+            self.beliefs,
+            self.regions,
+            self.in_views,
+            tuple(p_cmds),
+            tuple(e_cmds),
+            self.pursuer_plans,
+            self.evader_plans,
             losses,
         )
 

@@ -194,7 +194,7 @@ def test_a_team_counts_every_pairs_losses():
     loop = game.start()
     ticks = [loop.advance() for _ in range(loop.ticks)]
     pairs = {
-        (i, j): [tick.team.detections[i][j] is not None for tick in ticks]
+        (i, j): [tick.detections[i][j] is not None for tick in ticks]
         for i in range(2)
         for j in range(2)
     }

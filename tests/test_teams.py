@@ -17,11 +17,12 @@ from pegame.detectors.oracle import OracleDetector
 from pegame.errors import ConfigError, SpawnError, require
 from pegame.estimators.kalman import KalmanEstimator
 from pegame.game import (
+    TRAJECTORY_HEADER,
     Game,
     spawn,
     spawn_team,
     team_header,
-    team_trajectory_row,
+    trajectory_row,
     write_outcome,
 )
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid, save_map
@@ -250,9 +251,9 @@ def test_every_estimator_plays_a_team_with_one_belief_per_evader(estimator):
     loop = game.start()
     while not loop.done:
         tick = loop.advance()
-    assert len(tick.team.beliefs) == 2 and len(tick.team.detections) == 2
-    assert any(b.mean is not None for b in tick.team.beliefs)
-    for row in tick.team.detections:
+    assert len(tick.beliefs) == 2 and len(tick.detections) == 2
+    assert any(b.mean is not None for b in tick.beliefs)
+    for row in tick.detections:
         for j, detection in enumerate(row):
             assert detection is None or detection.evader == j
 
@@ -278,10 +279,13 @@ def test_handoffs_count_custody_passing_from_pursuer_to_pursuer(solo):
     assert summary["tracking_rate_per_pursuer"] == [pytest.approx(0.6), pytest.approx(0.4)]
 
 
-def test_a_1v1_tick_has_no_team_row():
+def test_a_1v1_ticks_row_is_its_team_row_under_the_1v1_names():
     tick = team_game().start().advance()
-    with pytest.raises(ValueError, match="no team row"):
-        team_trajectory_row(tick)
+    row = trajectory_row(tick)
+    assert len(row) == len(TRAJECTORY_HEADER) == len(team_header(1, 1))
+    p, e = tick.pursuer, tick.evader
+    assert row[2:8] == (p.x, p.y, p.theta, e.x, e.y, e.theta)
+    assert row[8:] == (int(tick.detection is not None), int(tick.in_view))
 
 
 def test_a_team_game_writes_every_agent_and_the_team_measures(tmp_path):

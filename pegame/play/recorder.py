@@ -66,7 +66,7 @@ def frame(
         "evader": [e.x, e.y, e.theta],
     }
     if "pursuer" in show or "cone" in show:
-        pursuers = tick.team.pursuers if tick.team is not None else (tick.pursuer,)
+        pursuers = tick.pursuers
         out["pursuers"] = [[p.x, p.y, p.theta] for p in pursuers]
     if "cone" in show:
         outlines = visibility_outlines(

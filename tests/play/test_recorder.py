@@ -20,7 +20,7 @@ from pegame.visibility.outlines import NEAR_ARC_POINTS
 
 def tick(belief: Belief) -> Tick:
     pursuer, evader = Pose(1.0, 1.0, 0.5), Pose(2.0, 1.5, -1.0)
-    return Tick(
+    return Tick.one_on_one(
         3,
         0.3,
         pursuer,

@@ -367,7 +367,7 @@ def synthetic_ticks(context: Context, count: int) -> list[Tick]:
             )
         visible = VisibilityRegion(context.grid, pursuer, context.camera)
         ticks.append(
-            Tick(
+            Tick.one_on_one(
                 step,
                 0.1 * step,
                 pursuer,
@@ -379,7 +379,6 @@ def synthetic_ticks(context: Context, count: int) -> list[Tick]:
                 detection is not None,
                 (Velocity(), Velocity()),
                 plans[decision],
-                None,
                 (Loss(0, 0, step, OCCLUDED),) if step == 4 else (),
             )
         )
@@ -485,7 +484,7 @@ def test_particles_of_equal_weight_are_sent_with_one_colour(tmp_path):
     equal = Belief(
         resampled.belief.mean, particles=resampled.belief.particles, weights=np.full(n, 1.0 / n)
     )
-    for tick in (weighted, dataclasses.replace(resampled, belief=equal)):
+    for tick in (weighted, dataclasses.replace(resampled, beliefs=(equal,))):
         recorder.log(tick)
     recorder.finish({})
     (chunk,) = [

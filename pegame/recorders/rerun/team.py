@@ -56,20 +56,19 @@ def _discs(positions: ArrayLike, radius: float, color: ArrayLike) -> dict[str, A
 def buffer_team(buffers: Buffers, tick: Tick, context: Context, max_particles: int) -> None:
     """Buffer the tick's team members past member 0 (module docstring), with at most
     ``max_particles`` particles per belief (0: none this tick); nothing in 1v1."""
-    team = tick.team
-    if team is None or (len(team.pursuers) == 1 and len(team.evaders) == 1):
+    if tick.solo:
         return
     step, time = tick.step, tick.time
     wedge = fov_template(context.camera)
-    for i, pose in enumerate(team.pursuers[1:], start=1):
+    for i, pose in enumerate(tick.pursuers[1:], start=1):
         body = _discs([(pose.x, pose.y)], context.pursuer.radius, PURSUER)
         buffers.add(f"world/pursuer_{i}/pose", rr.Points3D, step, time, **body)
         strip = [points_at(placed(wedge, pose), Z_REGION)]
         buffers.add(f"world/pursuer_{i}/fov", rr.LineStrips3D, step, time, strips=strip)
-    for j, pose in enumerate(team.evaders[1:], start=1):
+    for j, pose in enumerate(tick.evaders[1:], start=1):
         body = _discs([(pose.x, pose.y)], context.evader.radius, EVADER)
         buffers.add(f"world/evader_{j}/pose", rr.Points3D, step, time, **body)
-    for j, belief in enumerate(team.beliefs[1:], start=1):
+    for j, belief in enumerate(tick.beliefs[1:], start=1):
         mean = [] if belief.mean is None else [belief.mean]
         marker = _discs(mean, 0.12, ESTIMATE)
         marker["positions"] = points_at(mean, Z_MARKER)
@@ -81,7 +80,7 @@ def buffer_team(buffers: Buffers, tick: Tick, context: Context, max_particles: i
             buffers.add(f"world/belief_{j}/particles", rr.Points3D, step, time, **cloud)
     seen = [
         d.position
-        for i, row in enumerate(team.detections)
+        for i, row in enumerate(tick.detections)
         for j, d in enumerate(row)
         if d is not None and (i, j) != (0, 0)
     ]
