@@ -17,7 +17,7 @@ The headless outputs need no display: they draw one game (the run's only recordi
 the one ``--game`` names: a part of its path that no other recording's path has; a run
 recorded with ``recorder=none`` is drawn from its ``trajectory.csv``). On a remote machine
 the viewer itself can also be served to a browser: ``python -m rerun --serve-web
-<file.rrd>`` and open the printed address (forward the port over ssh).
+<dir>/pegame.rbl <file.rrd>`` and open the printed address (forward the port over ssh).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import sys
 from pathlib import Path
 
 from pegame.errors import PegameError
-from pegame.recorders.files import PARTIAL, recording_status
+from pegame.recorders.files import LAYOUT_FILE, PARTIAL, recording_status
 
 
 class ReplayError(PegameError):
@@ -55,8 +55,11 @@ def find_recordings(run_dir: str | Path) -> list[Path]:
 
 
 def viewer_command(files: list[Path]) -> list[str]:
-    """The command that opens ``files`` in one Rerun viewer."""
-    return [sys.executable, "-m", "rerun", *(str(path) for path in files)]
+    """The command that opens ``files`` in one Rerun viewer, after the layout files
+    (``pegame.rbl``, :mod:`pegame.recorders.rerun.blueprint`) of their directories."""
+    layouts = sorted({path.parent / LAYOUT_FILE for path in files})
+    shown = [path for path in layouts if path.is_file()] + files
+    return [sys.executable, "-m", "rerun", *(str(path) for path in shown)]
 
 
 def human_size(size: int) -> str:

@@ -18,6 +18,7 @@ import pytest
 
 from pegame.config import compose
 from pegame.game import Game
+from pegame.recorders.files import recording_status
 from pegame.replay import find_recordings, viewer_command
 from pegame.replay import main as replay_main
 
@@ -101,7 +102,8 @@ def test_every_recording_listed_as_complete_or_failed_passes_rrd_verify(run_dir,
 
 
 def test_a_killed_game_leaves_no_recording_and_a_cut_one_keeps_its_partial_name(run_dir):
-    assert not (run_dir / "job2").exists() or not list((run_dir / "job2").iterdir())
+    killed = run_dir / "job2"
+    assert not killed.exists() or not [p for p in killed.iterdir() if recording_status(p)]
     assert rrd_verify(run_dir / "job3" / "game_3.rrd.partial") != 0  # what the name says
 
 
@@ -130,7 +132,9 @@ def test_replay_finds_recordings_recursively_sorted(tmp_path, capsys):
         "job0/game_1.rrd",
         "job1/game_2.rrd",
     ]
-    assert viewer_command(files)[:3] == [sys.executable, "-m", "rerun"]
+    assert viewer_command(files) == [sys.executable, "-m", "rerun", *map(str, files)]
+    (tmp_path / "job0" / "pegame.rbl").write_bytes(b"layout")  # its directory's layout first
+    assert viewer_command(files)[3:] == [str(tmp_path / "job0" / "pegame.rbl"), *map(str, files)]
     assert replay_main([str(tmp_path), "--list"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines == [f"{p}  1.5 kB  complete" for p in files]

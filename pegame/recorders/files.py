@@ -31,6 +31,10 @@ from pathlib import Path
 
 COMPLETE, FAILED, PARTIAL = "complete", "failed", "partial"
 
+#: the blueprint file (the viewer's layout) of an output directory's recordings
+#: (:mod:`pegame.recorders.rerun.blueprint`)
+LAYOUT_FILE = "pegame.rbl"
+
 #: file name suffix per status, longest first (".failed.rrd" also ends in ".rrd")
 SUFFIXES = {FAILED: ".failed.rrd", PARTIAL: ".rrd.partial", COMPLETE: ".rrd"}
 

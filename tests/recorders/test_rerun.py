@@ -22,6 +22,7 @@ from pegame.figures import plot_trajectory
 from pegame.game import Game
 from pegame.grid import OccupancyGrid
 from pegame.losses import OCCLUDED, Loss
+from pegame.recorders.files import recording_status
 from pegame.recorders.rerun import RerunRecorder, recording_id
 from pegame.recorders.rerun.scene import HEAVY_PARTICLE
 from pegame.replay import find_recordings
@@ -134,7 +135,22 @@ def test_entities_have_one_row_per_step(played):
     for entity in ("/world/pursuer/path", "/world/evader/goal"):
         assert 1 <= len(steps[entity]) <= TICKS // 10 + 1, entity
     assert steps["/events"], "the start of tracking is an event"
-    assert len(blueprints) == 1
+    assert not blueprints  # the layout is the directory's, once for all its recordings
+
+
+def test_the_layout_is_written_once_per_directory_as_a_blueprint_file(played, tmp_path):
+    from rerun.chunk import RrdReader
+
+    from pegame.recorders.rerun.blueprint import write_layout
+
+    game, _, out_dir = played
+    layout = out_dir / "pegame.rbl"
+    assert len(RrdReader(layout).blueprints()) == 1
+    assert not RrdReader(layout).recordings()
+    before = layout.stat().st_mtime_ns
+    context = game.scenario.context  # the next game's recorder finds the file and keeps it
+    write_layout(out_dir, "pegame", context, False)
+    assert layout.stat().st_mtime_ns == before
 
 
 def test_fov_wedge_is_placed_at_the_pursuer_pose_every_step(played):
@@ -296,21 +312,27 @@ def test_a_failed_game_leaves_a_failed_recording_readable_up_to_its_failure(fail
     assert failure == {"error": "RuntimeError", "message": "pursuer broke", "step": 19}
 
 
+def recordings(out_dir: Path) -> list[str]:
+    """The names of the recording files in ``out_dir`` (not its layout file), sorted."""
+    return sorted(p.name for p in out_dir.iterdir() if recording_status(p))
+
+
 def test_a_finished_game_supersedes_its_failed_recording(tmp_path):
     context = small_context()
     for abort in (True, False):
         recorder = RerunRecorder(RerunRecorder.Config(), context, None)
         recorder.start(str(tmp_path), "game_3", {})
-        names = sorted(p.name for p in tmp_path.iterdir())
-        assert names == ([] if abort else ["game_3.failed.rrd"])  # held in memory meanwhile
+        assert recordings(tmp_path) == (
+            [] if abort else ["game_3.failed.rrd"]
+        )  # held in memory meanwhile
         for tick in synthetic_ticks(context, 6):
             recorder.log(tick)
         if abort:
             recorder.abort(KeyboardInterrupt())
-            assert sorted(p.name for p in tmp_path.iterdir()) == ["game_3.failed.rrd"]
+            assert recordings(tmp_path) == ["game_3.failed.rrd"]
         else:
             recorder.finish({})
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["game_3.rrd"]
+    assert recordings(tmp_path) == ["game_3.rrd"]
     assert rrd_verify(tmp_path / "game_3.rrd").returncode == 0
 
 
@@ -318,7 +340,7 @@ def test_a_game_that_fails_before_its_first_tick_leaves_a_failed_recording(tmp_p
     recorder = RerunRecorder(RerunRecorder.Config(), small_context(), None)
     recorder.start(str(tmp_path), "game", {"game": {"seed": 1}})
     recorder.abort(ValueError("bad spawn"))
-    assert [p.name for p in tmp_path.iterdir()] == ["game.failed.rrd"]
+    assert recordings(tmp_path) == ["game.failed.rrd"]
     steps, static, _ = read_steps(tmp_path / "game.failed.rrd")
     assert steps["/events"] == [0] and "/world/map" in static
 

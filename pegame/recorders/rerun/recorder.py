@@ -45,9 +45,8 @@ import rerun as rr
 from pegame.api import Context, Recorder, Tick
 from pegame.errors import ResultsWriteError, require
 from pegame.files import make_dir, write_atomic
-from pegame.grid import per_grid
 from pegame.recorders.files import COMPLETE, FAILED, PARTIAL, recording_path
-from pegame.recorders.rerun.blueprint import blueprint
+from pegame.recorders.rerun.blueprint import game_blueprint, write_layout
 from pegame.recorders.rerun.columns import ParticleRows, row_columns, tick_row, time_index
 from pegame.recorders.rerun.properties import (
     flat_config,
@@ -278,13 +277,7 @@ class RerunRecorder(Recorder):
         rec = self._rec
         assert rec is not None  # log returns early without a recording
         if self._last is None:
-            has_image = tick.frame.rgb is not None
-            layout = per_grid(
-                self.context.grid,
-                ("recorders.rerun", "blueprint", self.context.camera, has_image),
-                lambda grid: blueprint(grid, self.context.camera, has_image),
-            )
-            rec.send_blueprint(layout)
+            self._layout(rec, tick.frame.rgb is not None)
         self._last = tick
         self._rows.append(tick_row(tick))
         particles = self.config.max_particles if tick.step % self.config.particles_every == 0 else 0
@@ -299,6 +292,14 @@ class RerunRecorder(Recorder):
             log_image(rec, tick, self.context.camera, self.config.jpeg_quality)
         if (tick.step + 1) % self._flush_every == 0:
             self._flush()
+
+    def _layout(self, rec: rr.RecordingStream, has_image: bool) -> None:
+        """The layout file of the output directory (:mod:`.blueprint`); the layout itself
+        to a spawned viewer."""
+        assert self._game is not None  # logging only after start
+        write_layout(self._game[0], APPLICATION_ID, self.context, has_image)
+        if self.config.spawn:
+            rec.send_blueprint(game_blueprint(self.context, has_image))
 
     def _log_plans(self, tick: Tick) -> None:
         """Paths, goals and candidates, only when a strategy has made a new plan, and an

@@ -1,13 +1,14 @@
 """The scene of a recording: every entity path, how it looks and what it is sent.
 
 As in Rerun's nuScenes example, each entity tree has one ``log_<family>()``: the statics
-once per recording (:func:`log_static`: map, camera border, FOV wedge, config document,
-styles), the buffered ticks at each send (:func:`log_agents`, :func:`log_trails`,
-:func:`log_sensing`, :func:`log_plots`, :func:`log_particles`, with columns from
-:mod:`.columns`), and the rare rows: new plans (:class:`PlanRows`), events
-(:func:`buffer_event`) and images (:func:`log_image`, logged as they happen). The entity paths are listed in
-:mod:`pegame.recorders.rerun`. Positions are in the map frame (m); the heights Z_* (m)
-lift the overlays above the map so that nothing z-fights.
+once per recording (:func:`log_static`: map, camera border, FOV wedge, config document;
+the entities' looks, :func:`styles`, are the layout's), the buffered ticks at each send
+(:func:`log_agents`, :func:`log_trails`, :func:`log_sensing`, :func:`log_plots`,
+:func:`log_particles`, with columns from :mod:`.columns`), and the rare rows: new plans
+(:class:`PlanRows`), events (:func:`buffer_event`) and images (:func:`log_image`, logged
+as they happen). The entity paths are listed in :mod:`pegame.recorders.rerun`. Positions
+are in the map frame (m); the heights Z_* (m) lift the overlays above the map so that
+nothing z-fights.
 """
 
 from __future__ import annotations
@@ -56,7 +57,8 @@ AGENTS = (("pursuer", "p"), ("evader", "e"))  # entity tree and ROW column prefi
 
 
 def log_static(rec: rr.RecordingStream, context: Context, properties: dict[str, Any]) -> None:
-    """The map, the image border, the FOV wedge, the config document and every style."""
+    """The map, the image border, the FOV wedge and the config document (the entities'
+    looks are the layout's, :func:`styles`)."""
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     # The map is static; building its payload is the larger part of starting a recording.
     rec.log("world/map", per_grid(context.grid, ("recorders.rerun", "map"), grid_map), static=True)
@@ -72,8 +74,6 @@ def log_static(rec: rr.RecordingStream, context: Context, properties: dict[str, 
     dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's, when there, is faster
     text = f"```yaml\n{yaml.dump(properties, Dumper=dumper, sort_keys=False)}```\n"
     rec.log("config", rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN), static=True)
-    for path, style in styles(float(context.pursuer.radius), float(context.evader.radius)).items():
-        rec.log(path, style, static=True)
 
 
 def grid_map(grid: OccupancyGrid) -> rr.GridMap:
@@ -105,7 +105,8 @@ def fov_template(camera: Camera) -> np.ndarray:
 
 @lru_cache(maxsize=4)
 def styles(pursuer_radius: float, evader_radius: float) -> dict[str, Any]:
-    """Static colours and sizes (m) of every entity, logged once."""
+    """The colours and sizes (m) of every entity, per entity path: the layout's overrides
+    (:func:`.blueprint.blueprint`)."""
 
     def faded(color: tuple[int, ...], alpha: int = 160) -> tuple[int, ...]:
         return (*color[:3], alpha)
