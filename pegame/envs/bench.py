@@ -91,6 +91,9 @@ def _vector_steps_per_second(
     return actions.shape[0] * env.num_envs / (time.perf_counter() - start)
 
 
+#: rounds of the batched env timed before any other batched env exists in the process
+ALONE_ROUNDS = 5
+
 #: the paper's conditions as a batched env plays them (no env plays the paper's turns)
 PAPER_CONDITIONS = ("+experiment=paper_conditions", "game.turn_order=simultaneous")
 
@@ -127,6 +130,7 @@ def bench_vector_env(
     overrides: Sequence[str] = ("env=enclosed",),
     seed: int = 0,
     single_steps: int = 300,
+    scaling_base: int = 1024,
     **settings: Any,
 ) -> dict[str, float | int]:
     """The batched env (:mod:`pegame.envs.vector`) against the single env, in the same run.
@@ -144,7 +148,11 @@ def bench_vector_env(
     rate; a game that would end inside a round is reset first, untimed). Resets are not timed (a reset
     spawns each game in Python: its cost per game is ``vector_reset_ms_per_game``).
     Figures are medians over the rounds; ``vector_speedup_per_core`` is the median of the
-    rounds' ratios to the single env.
+    rounds' ratios to the single env. ``vector_beside_others_ratio``: the batched env's
+    one-core rate in those rounds (the smart opponents' envs alive beside it) over its rate
+    in ALONE_ROUNDS rounds before they were built; ``vector_scaling_over_smaller``: its rate
+    over the rate of an env of ``scaling_base`` games (``num_envs_smaller``, 1024) in the
+    same rounds (None at that many games or fewer).
     ``settings``: env options (:class:`pegame.observe.settings.EnvSettings`) for both.
     Memory per game: the resident memory the batched env added (its kernels already
     loaded), divided by the games; and the bytes of its arrays per game (state, opponent
@@ -175,6 +183,19 @@ def bench_vector_env(
     env.step(np.zeros((num_envs, 2), np.float32))
     memory = (_rss_bytes() - before) / num_envs
     arrays = _array_bytes(env) / num_envs
+    batch = 4
+    played = 1 + ALONE_ROUNDS * batch
+    alone = [
+        _vector_steps_per_second(
+            env, rng.uniform(-1.0, 1.0, (batch, num_envs, 2)).astype(np.float32), 1
+        )
+        for _ in range(ALONE_ROUNDS)
+    ]
+    smaller = None
+    if num_envs > scaling_base:
+        smaller = vector_env(scaling_base, overrides=random_evader, opponent="random", **settings)
+        smaller.reset(seed=seed)
+        smaller.step(np.zeros((scaling_base, 2), np.float32))
     smart = {
         key: _DecisionPeriods(
             vector_env(smart_envs, overrides=options, opponent="smart", **settings), seed
@@ -184,10 +205,8 @@ def bench_vector_env(
             ("smart_paper", [*overrides, *PAPER_CONDITIONS]),
         )
     }
-    per_round: dict[str, list[float]] = {"single": [], "core": [], "all": []}
+    per_round: dict[str, list[float]] = {"single": [], "core": [], "all": [], "smaller": []}
     per_round.update({key: [] for key in smart})
-    batch = 4
-    played = 1
     deadline = time.perf_counter() + seconds
     while time.perf_counter() < deadline and played + 3 * batch < env.game.steps:
         single.reset(seed=seed + played)
@@ -199,12 +218,15 @@ def bench_vector_env(
         actions = rng.uniform(-1.0, 1.0, (batch, num_envs, 2)).astype(np.float32)
         per_round["core"].append(_vector_steps_per_second(env, actions, 1))
         per_round["all"].append(_vector_steps_per_second(env, actions, threads))
+        if smaller is not None:
+            fewer = actions[:, :scaling_base]
+            per_round["smaller"].append(_vector_steps_per_second(smaller, fewer, 1))
         for key, periods in smart.items():
             per_round[key].append(periods.steps_per_second(rng))
         played += 3 * batch
     numba.set_num_threads(threads)
     single.close()
-    median = {key: statistics.median(values) for key, values in per_round.items()}
+    median = {key: statistics.median(values) for key, values in per_round.items() if values}
     ratios = [v / s for v, s in zip(per_round["core"], per_round["single"])]
     return {
         "num_envs": num_envs,
@@ -214,6 +236,12 @@ def bench_vector_env(
         "vector_env_steps_per_s": median["core"],
         "vector_env_steps_per_s_all_cores": median["all"],
         "vector_speedup_per_core": statistics.median(ratios),
+        "vector_env_steps_per_s_alone": statistics.median(alone),
+        "vector_beside_others_ratio": median["core"] / statistics.median(alone),
+        "num_envs_smaller": scaling_base,
+        "vector_scaling_over_smaller": (
+            median["core"] / median["smaller"] if "smaller" in median else None
+        ),
         "vector_reset_ms_per_game": 1e3 * reset_s / num_envs,
         "vector_env_bytes_per_game": memory,
         "vector_env_array_bytes_per_game": arrays,
@@ -239,11 +267,16 @@ def format_vector(report: dict) -> str:
     if report.get("vector_env_steps_per_s") is None:
         return "batched env: -"
     r = report
+    scaling = r.get("vector_scaling_over_smaller")
+    beside = f"beside other batched envs {r['vector_beside_others_ratio']:.2f}x its rate alone"
+    if scaling is not None:
+        beside += f", {scaling:.2f}x the rate of {r['num_envs_smaller']} games"
     return (
         f"batched env ({r['num_envs']} games, random evader): {r['vector_env_steps_per_s']:.0f} "
         f"steps/s on one core ({r['vector_speedup_per_core']:.1f}x the single env's "
         f"{r['single_env_steps_per_s']:.0f} in the same rounds), "
-        f"{r['vector_env_steps_per_s_all_cores']:.0f} on {r['numba_threads']} threads; "
+        f"{r['vector_env_steps_per_s_all_cores']:.0f} on {r['numba_threads']} threads "
+        f"({beside}); "
         f"{r['vector_env_bytes_per_game'] / 1024:.1f} KiB per game "
         f"({r['vector_env_array_bytes_per_game'] / 1024:.1f} KiB of arrays), reset "
         f"{r['vector_reset_ms_per_game']:.2f} ms per game; smart evader "

@@ -13,7 +13,12 @@ from pegame.envs.bench import bench_vector_env, format_vector
 @pytest.mark.slow
 def test_vector_bench_measures_every_figure_in_alternating_rounds():
     report = bench_vector_env(
-        seconds=0.2, num_envs=6, smart_envs=2, overrides=["env=enclosed"], single_steps=20
+        seconds=0.2,
+        num_envs=6,
+        smart_envs=2,
+        overrides=["env=enclosed"],
+        single_steps=20,
+        scaling_base=3,
     )
     assert report["rounds"] >= 1 and report["num_envs"] == 6
     for key in (
@@ -24,7 +29,11 @@ def test_vector_bench_measures_every_figure_in_alternating_rounds():
         "vector_env_steps_per_s_smart_paper",
         "vector_reset_ms_per_game",
         "vector_env_array_bytes_per_game",
+        "vector_env_steps_per_s_alone",
+        "vector_beside_others_ratio",
+        "vector_scaling_over_smaller",
     ):
         assert math.isfinite(report[key]) and report[key] > 0, key
-    assert "6 games" in format_vector(report)
+    line = format_vector(report)
+    assert "(6 games" in line and "x the rate of 3 games" in line
     assert format_vector({}) == "batched env: -"
