@@ -58,6 +58,7 @@ __all__ = [
     "Detector",
     "Estimator",
     "Evader",
+    "FirstMembers",
     "EvaderObservation",
     "INTERFACES",
     "PLUGIN_KINDS",
@@ -165,11 +166,71 @@ class Context:
     decision_dt: float
 
 
+class FirstMembers:
+    """Member 0's values under the 1v1 game's names, for a record that holds one value
+    per member (``pursuers``, ``evaders``, ``frames``, ``detections[i][j]``, ``beliefs``,
+    ``regions``, ``in_views[i][j]``, ``pursuer_plans``, ``evader_plans``): a
+    :class:`Tick`, and the :class:`pegame.loop.TickLoop` at its current tick."""
+
+    __slots__ = ()
+    pursuers: tuple[Pose, ...]
+    evaders: tuple[Pose, ...]
+    frames: tuple[SensorFrame, ...]
+    detections: tuple[tuple[Detection | None, ...], ...]
+    beliefs: tuple[Belief, ...]
+    regions: tuple[Region | None, ...]
+    in_views: tuple[tuple[bool, ...], ...]
+    pursuer_plans: tuple[Plan, ...]
+    evader_plans: tuple[Plan, ...]
+
+    @property
+    def pursuer(self) -> Pose:
+        """Pursuer 0's true pose."""
+        return self.pursuers[0]
+
+    @property
+    def evader(self) -> Pose:
+        """Evader 0's true pose."""
+        return self.evaders[0]
+
+    @property
+    def frame(self) -> SensorFrame:
+        """Pursuer 0's sensor frame."""
+        return self.frames[0]
+
+    @property
+    def detection(self) -> Detection | None:
+        """Pursuer 0's detection of evader 0, or None."""
+        return self.detections[0][0]
+
+    @property
+    def belief(self) -> Belief:
+        """The belief about evader 0."""
+        return self.beliefs[0]
+
+    @property
+    def region(self) -> Region | None:
+        """Pursuer 0's visibility region (None when not computed)."""
+        return self.regions[0]
+
+    @property
+    def in_view(self) -> bool:
+        """Ground truth: evader 0's body in the view of some pursuer."""
+        rows = self.in_views
+        return rows[0][0] if len(rows) == 1 else any(row[0] for row in rows)
+
+    @property
+    def plans(self) -> tuple[Plan, Plan]:
+        """(pursuer 0's, evader 0's) latest plans."""
+        return self.pursuer_plans[0], self.evader_plans[0]
+
+
 @value_type(eq=False)
-class Tick:
+class Tick(FirstMembers):
     """Everything that happened at one control tick of a game of N pursuers and M evaders
     (1v1: N = M = 1), as the recorder receives it; every field is per member, in member
-    order, and the properties below give member 0's for a 1v1 recorder.
+    order; member 0's values, for a 1v1 recorder, are properties (:class:`FirstMembers`,
+    and ``commands``).
 
     step: control tick index; time (s); pursuers (N) and evaders (M): true poses; frames:
     each pursuer's sensor frame; detections[i][j]: pursuer i's detection of evader j or
@@ -232,49 +293,9 @@ class Tick:
         )
 
     @property
-    def pursuer(self) -> Pose:
-        """Pursuer 0's true pose."""
-        return self.pursuers[0]
-
-    @property
-    def evader(self) -> Pose:
-        """Evader 0's true pose."""
-        return self.evaders[0]
-
-    @property
-    def frame(self) -> SensorFrame:
-        """Pursuer 0's sensor frame."""
-        return self.frames[0]
-
-    @property
-    def detection(self) -> Detection | None:
-        """Pursuer 0's detection of evader 0, or None."""
-        return self.detections[0][0]
-
-    @property
-    def belief(self) -> Belief:
-        """The belief about evader 0."""
-        return self.beliefs[0]
-
-    @property
-    def region(self) -> Region | None:
-        """Pursuer 0's visibility region (None when not computed)."""
-        return self.regions[0]
-
-    @property
-    def in_view(self) -> bool:
-        """Whether any pursuer has evader 0's body in view (ground truth)."""
-        return any(row[0] for row in self.in_views)
-
-    @property
     def commands(self) -> tuple[Velocity, Velocity]:
         """(pursuer 0's, evader 0's) velocities applied after this tick."""
         return self.pursuer_commands[0], self.evader_commands[0]
-
-    @property
-    def plans(self) -> tuple[Plan, Plan]:
-        """(pursuer 0's, evader 0's) latest plans."""
-        return self.pursuer_plans[0], self.evader_plans[0]
 
     @property
     def solo(self) -> bool:

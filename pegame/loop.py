@@ -65,6 +65,7 @@ from pegame.api import (
     Estimator,
     Evader,
     EvaderObservation,
+    FirstMembers,
     OneOnOneSimulator,
     Pursuer,
     PursuerObservation,
@@ -79,12 +80,10 @@ from pegame.losses import LossCauses
 from pegame.metrics import TeamMetrics, TrackingMetrics
 from pegame.types import (
     EMPTY_BELIEF,
-    Belief,
     Detection,
     Plan,
     Pose,
     Region,
-    SensorFrame,
     Velocity,
 )
 from pegame.visibility import UnionRegion, VisibilityRegion, body_in_view
@@ -148,7 +147,7 @@ def nearest(poses: Sequence[Pose], to: Pose) -> int:
     return distances.index(min(distances))
 
 
-class TickLoop:
+class TickLoop(FirstMembers):
     """Plays the ticks of one game in the order of the module docstring.
 
     plugins: the game's plugins (:class:`GamePlugins`, one per member of each role);
@@ -228,48 +227,6 @@ class TickLoop:
     def done(self) -> bool:
         """True once every tick of the game has been played."""
         return self.step >= self.ticks
-
-    # -- member 0's view, the 1v1 game's names
-
-    @property
-    def pursuer(self) -> Pose:
-        """Pursuer 0's true pose at the current tick."""
-        return self.pursuers[0]
-
-    @property
-    def evader(self) -> Pose:
-        """Evader 0's true pose at the current tick."""
-        return self.evaders[0]
-
-    @property
-    def detection(self) -> Detection | None:
-        """Pursuer 0's detection of evader 0 at the current tick."""
-        return self.detections[0][0]
-
-    @property
-    def belief(self) -> Belief:
-        """The belief about evader 0 at the current tick."""
-        return self.beliefs[0]
-
-    @property
-    def region(self) -> VisibilityRegion | None:
-        """Pursuer 0's visibility region at the current tick (None when not computed)."""
-        return self.regions[0]
-
-    @property
-    def frame(self) -> SensorFrame:
-        """Pursuer 0's sensor frame at the current tick."""
-        return self.frames[0]
-
-    @property
-    def in_view(self) -> bool:
-        """Ground truth: evader 0's body in the view of some pursuer at the current tick."""
-        return self.in_views[0][0] if self.solo else any(row[0] for row in self.in_views)
-
-    @property
-    def plans(self) -> tuple[Plan, Plan]:
-        """The latest (pursuer 0, evader 0) plans."""
-        return self.pursuer_plans[0], self.evader_plans[0]
 
     def start(self, pursuer: Pose | Sequence[Pose], evader: Pose | Sequence[Pose]) -> None:
         """Place the agents (a pose per role in 1v1, a sequence of poses per role for a

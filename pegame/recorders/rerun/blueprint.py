@@ -43,7 +43,8 @@ def blueprint(
     each entity's colours and sizes (:func:`.scene.styles`), given as the overrides of
     the view that shows it."""
 
-    def overrides(origin: str) -> dict[str, list[Any]]:
+    # Keys typed Any: rerun-sdk's overrides take a mapping keyed by EntityPath | str.
+    def overrides(origin: str) -> dict[Any, list[Any]]:
         return {path: [look] for path, look in looks.items() if path.startswith(f"{origin}/")}
 
     ox, oy, yaw = grid.origin
