@@ -20,7 +20,7 @@ metrics.add(current tick)              kernels.tally
 _integrate: substeps, pursuer then     sims.grid.move(pursuer), sims.grid.move(evader), per
 evader (GridSimulator.step)            substep (the simulator's own kernel)
 step += 1; _sense(): poses, detector,  steps += 1; camera.sense: camera.detect, then
-in_view                                camera.body_in_view
+in_view                                sight.silhouette_in_view
 EnvGame: reward += detection,          camera.sense (memory), state.rewards
 features.remember
 =====================================  =====================================================
