@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from pegame import numerics
 from pegame.api import Context, Detector
 from pegame.detectors.perception import (
     Perception,
@@ -55,7 +56,6 @@ from pegame.detectors.perception import (
 )
 from pegame.detectors.profile import DetectionProfile
 from pegame.errors import require
-from pegame.numerics import wrap_angle as wrap_angle_kernel
 from pegame.types import BoundingBox, Camera, Detection, Pose, SensorFrame, wrap_angle
 from pegame.visibility import in_view
 
@@ -104,8 +104,9 @@ def image(
     its bearing (rad, plus ``bearing_error``), its depth along the optical axis (m, plus
     ``depth_error``, at least near), the pinhole box (x, y, w, h) (px) of the body there,
     and the map position (m) back-projected from the box centre's bearing and the depth.
-    Returns (x, y, w, h, depth, position x, position y)."""
-    bearing = wrap_angle_kernel(math.atan2(ey - cy, ex - cx) - ctheta) + bearing_error
+    Returns (x, y, w, h, depth, position x, position y). (:func:`pegame.numerics.wrap_angle`
+    is :func:`pegame.types.wrap_angle` in numba code.)"""
+    bearing = numerics.wrap_angle(math.atan2(ey - cy, ex - cx) - ctheta) + bearing_error
     depth = distance * math.cos(bearing) + depth_error
     depth = depth if depth > camera[NEAR] else camera[NEAR]
     width, focal = camera[IMAGE_WIDTH], camera[FOCAL]
