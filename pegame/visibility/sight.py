@@ -7,7 +7,7 @@ bearing, range and line of sight of a point; :func:`body_in_view` extends it fro
 to a body, the ground truth of "the evader is in view". :func:`fov_wedge` is the field of
 view's polygon, for plots.
 
-The tests are the numba kernels here, and only here: :func:`segment_clear`,
+The visibility tests themselves are numba kernels, here and only here: :func:`segment_clear`,
 :func:`point_in_view` and :func:`silhouette_in_view` (with :func:`across`, the direction
 of a body's silhouette, which :func:`pegame.detectors.perception.silhouette_hidden`
 shares). The functions above call them for one pose, the batched game
