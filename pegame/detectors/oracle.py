@@ -27,6 +27,13 @@ evader's centre moved by the profile's error (measured from the centre), its box
 depth those of a body there; one uniform and two normal draws from the profile's
 generator per such frame (the depth and bearing noise are the profile's error, and
 refused beside it).
+
+The capture's geometry is the numba kernel :func:`image` (bearing, depth, the pinhole box
+of :func:`pegame.detectors.perception.pinhole`, the back-projection), on the camera's
+numbers (:func:`camera_numbers`, entries FOV..CAMERA_HEIGHT): the detector calls it for
+its one pose, the batched game (:func:`pegame.vector.camera.detect`) inlines it into its
+loop over games, so the two compute the same floats; the tests before it are
+:func:`pegame.visibility.in_view` and the perception model's (their kernels likewise).
 """
 
 from __future__ import annotations
@@ -35,13 +42,91 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
+from pegame import numerics
 from pegame.api import Context, Detector
-from pegame.detectors.perception import Perception, PerceptionConfig, hidden_fraction, pinhole_box
+from pegame.detectors.perception import (
+    Perception,
+    PerceptionConfig,
+    detection_range,
+    hidden_fraction,
+    pinhole,
+    pinhole_box,
+)
 from pegame.detectors.profile import DetectionProfile
 from pegame.errors import require
-from pegame.types import Detection, Pose, SensorFrame, wrap_angle
+from pegame.types import BoundingBox, Camera, Detection, Pose, SensorFrame, wrap_angle
 from pegame.visibility import in_view
+
+#: entries of the camera's numbers (:func:`camera_numbers`): fov (rad), near and far (m),
+#: the image's width and height (px), the focal length (px), the detection range (m), the
+#: evader's height and the camera's above the floor (m)
+FOV, NEAR, FAR, IMAGE_WIDTH, IMAGE_HEIGHT, FOCAL, DETECTION_RANGE, BODY_HEIGHT, CAMERA_HEIGHT = (
+    range(9)
+)
+
+
+def camera_numbers(camera: Camera, config: OracleDetector.Config) -> np.ndarray:
+    """float64 (9,): the numbers of ``camera`` and the detector's ``config`` that
+    :func:`image` reads, entries FOV..CAMERA_HEIGHT."""
+    return np.array(
+        [
+            camera.fov,
+            camera.near,
+            camera.far,
+            float(camera.image_width),
+            float(camera.image_height),
+            camera.focal_px,
+            detection_range(config, camera),
+            config.evader_height,
+            config.camera_height,
+        ],
+        dtype=np.float64,
+    )
+
+
+@njit(cache=True, inline="always")
+def image(
+    camera: np.ndarray,
+    cx: float,
+    cy: float,
+    ctheta: float,
+    ex: float,
+    ey: float,
+    distance: float,
+    bearing_error: float,
+    depth_error: float,
+    radius: float,
+) -> tuple[float, float, float, float, float, float, float]:
+    """The detection of an evader (a cylinder of ``radius`` m) at (ex, ey), ``distance`` m
+    from the camera at (cx, cy, ctheta) (m, m, rad; ``camera``: :func:`camera_numbers`):
+    its bearing (rad, plus ``bearing_error``), its depth along the optical axis (m, plus
+    ``depth_error``, at least near), the pinhole box (x, y, w, h) (px) of the body there,
+    and the map position (m) back-projected from the box centre's bearing and the depth.
+    Returns (x, y, w, h, depth, position x, position y). (:func:`pegame.numerics.wrap_angle`
+    is :func:`pegame.types.wrap_angle` in numba code.)"""
+    bearing = numerics.wrap_angle(math.atan2(ey - cy, ex - cx) - ctheta) + bearing_error
+    depth = distance * math.cos(bearing) + depth_error
+    depth = depth if depth > camera[NEAR] else camera[NEAR]
+    width, focal = camera[IMAGE_WIDTH], camera[FOCAL]
+    left, top, box_w, box_h = pinhole(
+        width,
+        camera[IMAGE_HEIGHT],
+        focal,
+        bearing,
+        distance,
+        depth,
+        radius,
+        camera[BODY_HEIGHT],
+        camera[CAMERA_HEIGHT],
+    )
+    seen_bearing = math.atan2(0.5 * width - (left + 0.5 * box_w), focal)
+    seen_range = depth / math.cos(seen_bearing)
+    heading = ctheta + seen_bearing
+    seen_x = cx + seen_range * math.cos(heading)
+    seen_y = cy + seen_range * math.sin(heading)
+    return left, top, box_w, box_h, depth, seen_x, seen_y
 
 
 class OracleDetector(Detector):
@@ -70,6 +155,7 @@ class OracleDetector(Detector):
         self.perception = Perception(
             config, context, rng, config.evader_height, config.camera_height
         )
+        self._camera = camera_numbers(context.camera, config)
         self.reset()
 
     def reset(self) -> None:
@@ -139,22 +225,19 @@ class OracleDetector(Detector):
                 return None
         if profile is not None:
             return self._profiled(cam, evader, profile)
-        bearing = math.atan2(evader.y - cam.y, evader.x - cam.x) - cam.theta
-        bearing = wrap_angle(bearing)
-        if cfg.bearing_noise > 0:
-            bearing += perception.bearing_error()
-        depth = max(
-            camera.near, distance * math.cos(bearing) + perception.depth_std(distance) * noise
+        x, y, w, h, depth, seen_x, seen_y = image(
+            self._camera,
+            cam.x,
+            cam.y,
+            cam.theta,
+            evader.x,
+            evader.y,
+            distance,
+            perception.bearing_error(),
+            perception.depth_std(distance) * noise,
+            self.context.evader.radius,
         )
-        radius = self.context.evader.radius
-        box = pinhole_box(
-            camera, bearing, distance, depth, radius, cfg.evader_height, cfg.camera_height
-        )
-        seen_bearing = camera.bearing_of(box.center_x)
-        seen_range = depth / math.cos(seen_bearing)
-        heading = cam.theta + seen_bearing
-        position = (cam.x + seen_range * math.cos(heading), cam.y + seen_range * math.sin(heading))
-        return Detection(box=box, depth=depth, position=position)
+        return Detection(box=BoundingBox(x, y, w, h), depth=depth, position=(seen_x, seen_y))
 
     def _profiled(self, cam: Pose, evader: Pose, profile: DetectionProfile) -> Detection:
         """A detected evader under a profile: its centre moved by the profile's error (in

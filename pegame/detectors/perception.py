@@ -51,9 +51,12 @@ noise, through :meth:`Perception.degrade` or the building blocks), and the pipel
 rate, latency, bursts and false positives.
 
 The pipeline's schedule (:func:`frame_due`, :func:`deliver_frame`, on the pipelines of a
-batch of detectors, :func:`new_pipeline`) and the range and occlusion miss chance
-(:func:`miss_chance`) are numba kernels: a :class:`Perception` runs them on a batch of
-one, the batched game (:mod:`pegame.vector`) on its games, so the two are one model.
+batch of detectors, :func:`new_pipeline`), the range and occlusion miss chance
+(:func:`miss_chance`), the hidden fraction (:func:`silhouette_hidden`, the points of
+:func:`pegame.visibility.sight.silhouette_in_view`) and the pinhole box
+(:func:`pinhole`) are numba kernels: a :class:`Perception` and the detectors run them on a
+batch of one or for one pose, the batched game (:mod:`pegame.vector`) on its games, so
+the two are one model.
 The results in flight are the caller's (a slot index per result: Python objects here,
 rows of arrays in the batched game).
 """
@@ -71,7 +74,7 @@ from numba import njit
 from pegame.detectors.profile import DetectionProfile, resolve
 from pegame.errors import ConfigError, require
 from pegame.types import XY, BoundingBox, Camera, Detection, Pose, wrap_angle
-from pegame.visibility import SILHOUETTE, in_view
+from pegame.visibility.sight import SILHOUETTE, across, point_in_view, sight_tables
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     from pegame.api import Context
@@ -220,6 +223,35 @@ def detection_range(config: PerceptionConfig, camera: Camera) -> float:
     return camera.far if config.detection_range is None else config.detection_range
 
 
+@njit(cache=True, inline="always")
+def pinhole(
+    width: float,
+    height: float,
+    focal: float,
+    bearing: float,
+    distance: float,
+    depth: float,
+    radius: float,
+    body_height: float,
+    camera_height: float,
+) -> tuple[float, float, float, float]:
+    """Kernel of :func:`pinhole_box`: the box (x, y, w, h) (px) of that body seen by a
+    pinhole camera of an image ``width`` x ``height`` px and horizontal focal length
+    ``focal`` px (``Camera.focal_px``; a column is ``Camera.column_of`` its bearing)."""
+    ratio = radius / distance
+    half = math.asin(ratio if ratio < 1.0 else 1.0)
+    left = 0.5 * width - focal * math.tan(bearing + half)
+    left = left if left > 0.0 else 0.0
+    right = 0.5 * width - focal * math.tan(bearing - half)
+    right = right if right < width else width
+    middle = 0.5 * height
+    top = middle - focal * (body_height - camera_height) / depth
+    top = top if top > 0.0 else 0.0
+    bottom = middle + focal * camera_height / depth
+    bottom = bottom if bottom < height else height
+    return left, top, right - left, bottom - top
+
+
 def pinhole_box(
     camera: Camera,
     bearing: float,
@@ -232,14 +264,60 @@ def pinhole_box(
     """The image box (px) of an upright cylinder of ``radius`` and ``height`` m standing at
     ``distance`` m (horizontal, to its axis) and ``bearing`` rad (left of the optical axis),
     ``depth`` m along the axis, seen by the pinhole ``camera`` mounted ``camera_height`` m
-    above the floor; clipped to the image."""
-    half = math.asin(min(1.0, radius / distance))
-    left = max(0.0, camera.column_of(bearing + half))
-    right = min(float(camera.image_width), camera.column_of(bearing - half))
-    focal, cy = camera.focal_px, 0.5 * camera.image_height
-    top = max(0.0, cy - focal * (height - camera_height) / depth)
-    bottom = min(float(camera.image_height), cy + focal * camera_height / depth)
-    return BoundingBox(left, top, right - left, bottom - top)
+    above the floor; clipped to the image (:func:`pinhole`)."""
+    width, image_height = float(camera.image_width), float(camera.image_height)
+    return BoundingBox(
+        *pinhole(
+            width,
+            image_height,
+            camera.focal_px,
+            bearing,
+            distance,
+            depth,
+            radius,
+            height,
+            camera_height,
+        )
+    )
+
+
+@njit(cache=True, inline="always")
+def silhouette_hidden(
+    frame: np.ndarray,
+    blocked: np.ndarray,
+    values: np.ndarray,
+    near: float,
+    far: float,
+    fov: float,
+    px: float,
+    py: float,
+    ptheta: float,
+    x: float,
+    y: float,
+    radius: float,
+) -> float:
+    """Kernel of :func:`hidden_fraction`: the fraction of the SILHOUETTE points of the body
+    of ``radius`` m at (x, y) (m) not in view of the camera at (px, py, ptheta), each
+    point tested by :func:`pegame.visibility.sight.point_in_view` (the grid and camera
+    numbers as it takes them)."""
+    ax, ay = across(px, py, x, y)
+    hidden = 0
+    for k in SILHOUETTE:
+        if not point_in_view(
+            frame,
+            blocked,
+            values,
+            near,
+            far,
+            fov,
+            px,
+            py,
+            ptheta,
+            x + k * radius * ax,
+            y + k * radius * ay,
+        ):
+            hidden += 1
+    return hidden / len(SILHOUETTE)
 
 
 def hidden_fraction(
@@ -247,16 +325,23 @@ def hidden_fraction(
 ) -> float:
     """The fraction in [0, 1] of the silhouette points of a body (an upright cylinder of
     ``radius`` m at the map-frame point ``centre_xy``) that the camera at ``pose`` does not
-    see: the same points, across the line of sight, as :func:`pegame.visibility.body_in_view`."""
-    x, y = float(centre_xy[0]), float(centre_xy[1])
-    dx, dy = x - pose.x, y - pose.y
-    distance = math.hypot(dx, dy)
-    across = (-dy / distance, dx / distance) if distance > 0.0 else (0.0, 0.0)
-    hidden = sum(
-        not in_view(grid, camera, pose, (x + k * radius * across[0], y + k * radius * across[1]))
-        for k in SILHOUETTE
+    see: the same points, across the line of sight, as :func:`pegame.visibility.body_in_view`
+    (:func:`silhouette_hidden`)."""
+    frame, values = sight_tables(grid)
+    return silhouette_hidden(
+        frame,
+        grid.blocked,
+        values,
+        camera.near,
+        camera.far,
+        camera.fov,
+        pose.x,
+        pose.y,
+        pose.theta,
+        float(centre_xy[0]),
+        float(centre_xy[1]),
+        float(radius),
     )
-    return hidden / len(SILHOUETTE)
 
 
 def pipeline_slots(latency: float, period: float) -> int:

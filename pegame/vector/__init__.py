@@ -3,7 +3,8 @@
 - :mod:`pegame.vector.game`: :class:`BatchedGame`, many games of one scenario, each the
   game the single env plays with the same seed, in the tick loop's order;
 - :mod:`pegame.vector.kernels`: the tick of every game (the grid simulator's own move
-  kernel, the measures) as numba kernels, parallel over games; :mod:`pegame.vector.camera` (detector, ground truth) and
+  kernel, the measures) as numba kernels, parallel over games; :mod:`pegame.vector.camera`
+  (detector, ground truth: the visibility and detector plugins' own kernels) and
   :mod:`pegame.vector.features` (observations) per game; :mod:`pegame.vector.state` the
   arrays and numbers they take;
 - :mod:`pegame.vector.opponents`: the scripted opponent of a learner;

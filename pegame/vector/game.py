@@ -20,7 +20,7 @@ metrics.add(current tick)              kernels.tally
 _integrate: substeps, pursuer then     sims.grid.move(pursuer), sims.grid.move(evader), per
 evader (GridSimulator.step)            substep (the simulator's own kernel)
 step += 1; _sense(): poses, detector,  steps += 1; camera.sense: camera.detect, then
-in_view                                camera.body_in_view
+in_view                                sight.silhouette_in_view
 EnvGame: reward += detection,          camera.sense (memory), state.rewards
 features.remember
 =====================================  =====================================================
@@ -56,11 +56,10 @@ import numpy as np
 from omegaconf import DictConfig
 
 from pegame.api import Context
-from pegame.detectors.oracle import OracleDetector
+from pegame.detectors.oracle import OracleDetector, camera_numbers
 from pegame.detectors.perception import (
     PerceptionConfig,
     capture_period,
-    detection_range,
     misses_by_range_or_occlusion,
     part_generators,
     pipeline_slots,
@@ -89,6 +88,7 @@ from pegame.vector.state import (
     World,
     new_state,
 )
+from pegame.visibility.sight import sight_tables
 
 #: the oracle detector's perception fields the kernels play only off, and that value
 PERCEPTION_OFF = {
@@ -282,15 +282,16 @@ def _world(grid: OccupancyGrid, context: Context, settings: EnvSettings) -> Worl
             shared_inflation(grid, context.evader.radius),
         ]
     )
+    frame, sight_values = sight_tables(grid)
     return World(
         grid.blocked,
-        np.array(grid.kernel_frame, dtype=np.float64),
+        frame,
         masks,
         *crop._samples,
         crop._lattice.frame,
         crop._lattice.table,
         crop._lattice.centres,
-        np.concatenate([[True], grid.blocked.ravel()]),
+        sight_values,
         np.array([x0, y0, 2.0 / (x1 - x0), 2.0 / (y1 - y0), math.hypot(x1 - x0, y1 - y0)]),
     )
 
@@ -336,25 +337,12 @@ def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
 
 def _rules(scenario: Scenario) -> Rules:
     context, settings = scenario.context, scenario.settings
-    camera, detector = context.camera, scenario.configs["detector"]
+    detector = scenario.configs["detector"]
+    assert isinstance(detector, OracleDetector.Config)  # check_playable: the oracle's
     bodies = body_rows(context.pursuer, context.evader)
-    numbers = np.array(
-        [
-            camera.fov,
-            camera.near,
-            camera.far,
-            float(camera.image_width),
-            float(camera.image_height),
-            camera.focal_px,
-            detection_range(detector, camera),
-            detector.evader_height,
-            detector.camera_height,
-        ],
-        dtype=np.float64,
-    )
     return Rules(
         bodies,
-        numbers,
+        camera_numbers(context.camera, detector),
         _perception(detector, float(context.control_dt)),
         float(context.control_dt),
         int(settings.substeps),

@@ -10,6 +10,16 @@ from typing import NamedTuple
 
 import numpy as np
 
+# the entries of ``rules.camera``: the oracle detector's camera numbers
+from pegame.detectors.oracle import BODY_HEIGHT as BODY_HEIGHT
+from pegame.detectors.oracle import CAMERA_HEIGHT as CAMERA_HEIGHT
+from pegame.detectors.oracle import DETECTION_RANGE as DETECTION_RANGE
+from pegame.detectors.oracle import FAR as FAR
+from pegame.detectors.oracle import FOCAL as FOCAL
+from pegame.detectors.oracle import FOV as FOV
+from pegame.detectors.oracle import IMAGE_HEIGHT as IMAGE_HEIGHT
+from pegame.detectors.oracle import IMAGE_WIDTH as IMAGE_WIDTH
+from pegame.detectors.oracle import NEAR as NEAR
 from pegame.detectors.perception import new_pipeline
 
 # the columns of ``rules.bodies``: the grid simulator's move kernel's
@@ -21,10 +31,6 @@ from pegame.sims.grid import W_MAX as W_MAX
 
 #: the roles' index in the role axes
 PURSUER, EVADER = 0, 1
-#: entries of ``rules.camera``
-FOV, NEAR, FAR, IMAGE_WIDTH, IMAGE_HEIGHT, FOCAL, DETECTION_RANGE, BODY_HEIGHT, CAMERA_HEIGHT = (
-    range(9)
-)
 #: entries of ``rules.perception`` (the perception model's parts the batched game plays,
 #: :mod:`pegame.detectors.perception`): the capture period (s), whether a rate sets it,
 #: the latency (s), whether the pipeline runs (else each tick delivers its own capture),
@@ -73,7 +79,8 @@ class World(NamedTuple):
     in a border of ``pad`` blocked cells wider than the crop's reach, the crop's look-up
     table; crop_centres: float64 (crop_cells,): the crop's cell centres along one axis
     (m; crop_x and crop_y are their grid); sight_values: bool (1 + H * W,): True (off
-    the grid), then ``blocked`` flat, the line of sight's look-up table;
+    the grid), then ``blocked`` flat, the line of sight's look-up table (``frame`` and
+    it: :func:`pegame.visibility.sight.sight_tables`);
     extent: (x0, y0, 2 / width, 2 / height, diagonal) of the observations' normalisation.
     """
 
@@ -95,9 +102,9 @@ class Rules(NamedTuple):
 
     bodies: (2, 5) float64 per role (pursuer, evader): radius (m), v_max (m/s), w_max
     (rad/s), a_max (m/s^2), alpha_max (rad/s^2); camera: float64 (9,) as the constants
-    FOV..CAMERA_HEIGHT; perception: float64 (8,) as the constants PERIOD..OCCLUSION_MISS;
-    control_dt (s); substeps per control tick; decide_every: control
-    ticks per decision; ticks: control ticks per game.
+    FOV..CAMERA_HEIGHT (:func:`pegame.detectors.oracle.camera_numbers`); perception:
+    float64 (8,) as the constants PERIOD..OCCLUSION_MISS; control_dt (s); substeps per
+    control tick; decide_every: control ticks per decision; ticks: control ticks per game.
     """
 
     bodies: np.ndarray

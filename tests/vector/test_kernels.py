@@ -1,6 +1,8 @@
 """The batched game's kernels (pegame.vector) against the plain code they reproduce, bit for
-bit: the crop and the in-view tests (Python's hypot and angle wrap in numba:
-tests/test_numerics.py; the move is the grid simulator's own kernel, tests/sims)."""
+bit: the crop, and the sensing kernels (pegame.visibility.sight, pegame.detectors) that
+the scalar functions and the batched game both run, against plain Python references of
+the tests (Python's hypot and angle wrap in numba: tests/test_numerics.py; the move is the
+grid simulator's own kernel, tests/sims)."""
 
 from __future__ import annotations
 
@@ -9,15 +11,44 @@ import math
 import numpy as np
 import pytest
 
+from pegame.detectors.perception import hidden_fraction, silhouette_hidden
 from pegame.envs.vector import vector_env
 from pegame.grid import OccupancyGrid
 from pegame.observe.crop import local_crop_reference
-from pegame.types import Pose
-from pegame.vector import camera as batched_camera
+from pegame.types import Camera, Pose, wrap_angle
 from pegame.vector.features import crop_into
 from pegame.vector.game import _world
-from pegame.visibility import body_in_view, in_view
-from pegame.visibility.sight import _segment_clear
+from pegame.visibility import SILHOUETTE, body_in_view, in_view
+from pegame.visibility.sight import (
+    _line_of_sight_reference,
+    point_in_view,
+    segment_clear,
+    silhouette_in_view,
+)
+
+
+def reference_in_view(grid: OccupancyGrid, camera: Camera, pose: Pose, x: float, y: float) -> bool:
+    """In view in plain Python: range (math.hypot), bearing (math.remainder's wrap), then
+    the numpy line of sight at half a cell."""
+    dx, dy = x - pose.x, y - pose.y
+    if not camera.near <= math.hypot(dx, dy) <= camera.far:
+        return False
+    if abs(wrap_angle(math.atan2(dy, dx) - pose.theta)) > 0.5 * camera.fov:
+        return False
+    return _line_of_sight_reference(grid, (pose.x, pose.y), (x, y), 0.5 * grid.resolution)
+
+
+def reference_silhouette(
+    grid: OccupancyGrid, camera: Camera, pose: Pose, x: float, y: float, radius: float
+) -> list[bool]:
+    """Whether each SILHOUETTE point of the body at (x, y) is in view, in plain Python."""
+    dx, dy = x - pose.x, y - pose.y
+    distance = math.hypot(dx, dy)
+    ax, ay = (-dy / distance, dx / distance) if distance > 0.0 else (0.0, 0.0)
+    return [
+        reference_in_view(grid, camera, pose, x + k * radius * ax, y + k * radius * ay)
+        for k in SILHOUETTE
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -109,12 +140,16 @@ def test_crop_on_a_rotated_far_off_grid_is_the_reference_crop(game):
     assert 0.02 < np.mean(slow) < 0.98  # both routes were taken
 
 
-def test_in_view_tests_are_the_visibility_functions(game):
+def test_in_view_tests_are_the_plain_references(game):
+    """The point and body in view and the hidden fraction, called for one pose (the
+    scalar functions) and as the batched game inlines them (the kernels on the World's
+    arrays), are the plain references."""
     world, grid, camera = game.world, game.context.grid, game.context.camera
-    numbers = game.rules.camera
+    sight = world.frame, world.blocked, world.sight_values
+    lens = camera.near, camera.far, camera.fov
     rng = np.random.default_rng(3)
     free = np.argwhere(~grid.blocked)
-    seen = 0
+    seen = partly = 0
     for _ in range(3000):
         (r, c), (r2, c2) = free[rng.integers(len(free), size=2)]
         px, py = grid.cell_to_world(r, c)
@@ -122,18 +157,24 @@ def test_in_view_tests_are_the_visibility_functions(game):
         ex, ey = ex + rng.uniform(-0.5, 0.5), ey + rng.uniform(-0.5, 0.5)
         theta = math.atan2(ey - py, ex - px) + rng.uniform(-0.7, 0.7)
         pose = Pose(px, py, theta)
-        centre = in_view(grid, camera, pose, (ex, ey))
-        sight = world.frame, world.blocked, world.sight_values
-        assert batched_camera.point_in_view(*sight, numbers, px, py, theta, ex, ey) == centre
-        body = batched_camera.body_in_view(*sight, numbers, px, py, theta, ex, ey, 0.25, centre)
-        assert body == body_in_view(grid, camera, pose, (ex, ey), 0.25)
+        points = reference_silhouette(grid, camera, pose, ex, ey, 0.25)
+        centre = reference_in_view(grid, camera, pose, ex, ey)
+        assert in_view(grid, camera, pose, (ex, ey)) == centre
+        assert point_in_view(*sight, *lens, px, py, theta, ex, ey) == centre
+        assert body_in_view(grid, camera, pose, (ex, ey), 0.25) == any(points)
+        assert silhouette_in_view(*sight, *lens, px, py, theta, ex, ey, 0.25, 1) == any(points[1:])
+        hidden = points.count(False) / len(SILHOUETTE)
+        assert hidden_fraction(grid, camera, pose, (ex, ey), 0.25) == hidden
+        assert silhouette_hidden(*sight, *lens, px, py, theta, ex, ey, 0.25) == hidden
         seen += centre
+        partly += 0 < hidden < 1
     assert 100 < seen < 2900  # both outcomes were tested
+    assert partly > 30  # and bodies partly hidden
 
 
-def test_segment_clear_on_cell_edges_is_the_sight_kernel(game):
+def test_segment_clear_on_cell_edges_is_the_reference(game):
     """Segments along the map's lattice lines (their samples on cell edges: the division
-    route) and random ones (the product route) give _segment_clear's answer."""
+    route) and random ones (the product route) give the numpy reference's answer."""
     world, grid = game.world, game.context.grid
     res, (gx, gy, _) = grid.resolution, grid.origin
     height, width = grid.blocked.shape
@@ -146,8 +187,8 @@ def test_segment_clear_on_cell_edges_is_the_sight_kernel(game):
         ax, ay, bx, by = gx + c * res, gy + r * res, gx + c2 * res, gy + r2 * res
         if i % 4 == 3:
             ax, ay = ax + rng.uniform(0, res), ay + rng.uniform(0, res)
-        want = _segment_clear(grid.blocked, ax, ay, bx, by, 0.5 * res, grid.kernel_frame)
+        want = _line_of_sight_reference(grid, (ax, ay), (bx, by), 0.5 * res)
         sight = world.frame, world.blocked, world.sight_values
-        assert batched_camera.segment_clear(*sight, ax, ay, bx, by, 0.5 * res) == want
+        assert segment_clear(*sight, ax, ay, bx, by, 0.5 * res) == want
         clear.append(want)
     assert 0.05 < np.mean(clear) < 0.95  # both outcomes were tested

@@ -1,6 +1,6 @@
 """Property-based tests of the line of sight (pegame.visibility.sight): the numba kernel
-against its numpy reference and its batched twin (pegame.vector.camera) on generated
-grids, segments (on cell corners too) and sampling steps, and what a clear line means:
+(the scalar function's and the batched game's, pegame.vector.camera) against its numpy
+reference on generated grids, segments (on cell corners too) and sampling steps, and what a clear line means:
 free end points, no clear line through more obstacles that was not clear before, a clear
 line inside one free cell. Units: metres in the map frame."""
 
@@ -14,7 +14,6 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from pegame.vector import camera as batched_camera
 from pegame.visibility import line_of_sight
 from pegame.visibility.sight import _line_of_sight_reference
 
@@ -38,16 +37,6 @@ def grids(draw: st.DrawFn) -> OccupancyGrid:
 STEPS = st.none() | st.floats(0.002, 0.2)
 
 
-def batched_segment_clear(
-    grid: OccupancyGrid, a: tuple[float, float], b: tuple[float, float], step: float
-) -> bool:
-    """The batched game's twin of the kernel on ``grid`` (its World's arrays built here:
-    the frame as float64, the look-up table True off the grid, then ``blocked`` flat)."""
-    frame = np.array(grid.kernel_frame, dtype=np.float64)
-    values = np.concatenate([[True], grid.blocked.ravel()])
-    return batched_camera.segment_clear(frame, grid.blocked, values, *a, *b, step)
-
-
 @settings(max_examples=300)
 @given(grids(), POINTS, POINTS, STEPS)
 def test_kernel_equals_reference(
@@ -56,7 +45,6 @@ def test_kernel_equals_reference(
     fast = line_of_sight(grid, a, b, step)
     sampled = 0.5 * grid.resolution if step is None else step
     assert fast == _line_of_sight_reference(grid, a, b, sampled)
-    assert fast == batched_segment_clear(grid, a, b, sampled)
 
 
 #: a free 1 x 2 grid and a segment to a point a hair off it, where a + (b - a) rounds
@@ -72,7 +60,7 @@ def test_a_clear_line_has_free_end_points(
 ) -> None:
     clear = line_of_sight(grid, a, b, step)
     sampled = 0.5 * grid.resolution if step is None else step
-    assert clear == batched_segment_clear(grid, a, b, sampled)
+    assert clear == _line_of_sight_reference(grid, a, b, sampled)
     if clear:
         assert grid.is_free(*a)
         assert grid.is_free(*b)
