@@ -136,7 +136,10 @@ class RerunRecorder(Recorder):
         self._stream: rr.BinaryStream | None = None  # the recording's bytes until written
         self._flush_every = config.live_flush_every if config.spawn else config.flush_every
         self._rows: list[tuple] = []  # columns.tick_row of each tick since the last send
-        self._particles = ParticleRows(self._flush_every, config.max_particles, Z_PARTICLES)
+        # Particle rows between two sends: the ticks of a send's window that are multiples
+        # of particles_every.
+        rows = -(-self._flush_every // config.particles_every)
+        self._particles = ParticleRows(rows, config.max_particles, Z_PARTICLES)
         self._buffers = Buffers()
         self._trail_ends: dict[str, np.ndarray] = {}  # per agent, the last trajectory point (1, 3)
         self._plans: list = [None, None]  # the latest (pursuer, evader) plans
