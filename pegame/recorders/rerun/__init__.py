@@ -4,15 +4,16 @@
 
 =================== ===================================================================
 :mod:`.recorder`    :class:`RerunRecorder`: start, log, finish or abort, the sends
-:mod:`.scene`       every entity path: statics, styles and one ``log_<family>()`` each
+:mod:`.scene`       every entity path: statics, looks and one ``log_<family>()`` each
 :mod:`.columns`     the buffers between sends and their encoding as Rerun columns
-:mod:`.blueprint`   the default layout of the viewer
+:mod:`.blueprint`   the viewer's layout, with the entities' looks, written once per
+                    output directory as ``pegame.rbl``
 :mod:`.properties`  the recording's id, name and properties (config, result, failure)
 =================== ===================================================================
 
 Files: ``<out_dir>/<game_id>.rrd.partial`` while the game runs, renamed to
 ``<game_id>.rrd`` when it finishes or ``<game_id>.failed.rrd`` when it raises (see
-:mod:`pegame.recorders.files`).
+:mod:`pegame.recorders.files`); ``<out_dir>/pegame.rbl``, the layout of all of them.
 
 Timelines: ``step`` (control tick index, sequence) and ``sim_time`` (simulation time,
 duration in s). Entity paths below; ``world`` is the map frame in metres, right-handed
