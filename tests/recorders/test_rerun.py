@@ -50,7 +50,6 @@ PER_TICK = [
     "/world/evader/heading",
     "/world/detection",
     "/world/belief/mean",
-    "/camera/detection",
     "/plots/tracking/detected",
     "/plots/tracking/rate",
     "/plots/distance/true",
@@ -574,3 +573,24 @@ def test_plot_trajectory_takes_csv_text_and_a_rotated_map(tmp_path):
         grid, rows, tmp_path / "trajectory.png", title="S-R (smart vs random) on box: " * 3
     )
     assert path.stat().st_size > 1000
+
+
+def test_detection_boxes_are_logged_on_the_image_plane_only_when_there_are_images(tmp_path):
+    context = small_context()
+    ticks = synthetic_ticks(context, 6)
+    width, height = context.camera.image_width, context.camera.image_height
+    rgb = np.zeros((height, width, 3), dtype=np.uint8)
+    with_images = [
+        dataclasses.replace(t, frames=(dataclasses.replace(t.frame, rgb=rgb),)) for t in ticks
+    ]
+    for name, played in (("grid", ticks), ("images", with_images)):
+        recorder = RerunRecorder(RerunRecorder.Config(), context, None)
+        recorder.start(str(tmp_path / name), "game", {})
+        for tick in played:
+            recorder.log(tick)
+        recorder.finish({})
+    grid, _, _ = read_steps(tmp_path / "grid" / "game.rrd")
+    images, _, _ = read_steps(tmp_path / "images" / "game.rrd")
+    assert "/camera/detection" not in grid and "/world/detection" in grid
+    assert images["/camera/detection"] == list(range(6))
+    assert images["/camera/image"] == [0]  # image_every (10) ticks

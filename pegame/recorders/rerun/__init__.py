@@ -43,7 +43,8 @@ world/belief/particles     Points3D coloured by weight, a strided subsample,
                            every ``particles_every`` ticks
 camera/frame               LineStrips2D, the image border (static)
 camera/image               JPEG of ``frame.rgb`` every ``image_every`` ticks, if any
-camera/detection           Boxes2D, the detection's bounding box (px)   every tick
+camera/detection           Boxes2D, the detection's bounding box (px)   every tick,
+                           when the simulator renders images
 plots/tracking/detected    Scalars: detected (0/1)                      every tick
 plots/tracking/rate        Scalars: running tracking rate               every tick
 plots/distance/true        Scalars: pursuer-evader distance (m)         every tick

@@ -149,6 +149,7 @@ class RerunRecorder(Recorder):
         self._changed_at = 0.0
         self._detections = 0
         self._last: Tick | None = None
+        self._has_image = False  # whether the simulator renders images (known at the first tick)
 
     # ------------------------------------------------------------ the Recorder API
 
@@ -280,7 +281,8 @@ class RerunRecorder(Recorder):
         rec = self._rec
         assert rec is not None  # log returns early without a recording
         if self._last is None:
-            self._layout(rec, tick.frame.rgb is not None)
+            self._has_image = tick.frame.rgb is not None
+            self._layout(rec, self._has_image)
         self._last = tick
         self._rows.append(tick_row(tick))
         particles = self.config.max_particles if tick.step % self.config.particles_every == 0 else 0
@@ -354,7 +356,7 @@ class RerunRecorder(Recorder):
             steps, times = c["step"].astype(np.int64), c["time"]
             every = time_index(indexes, steps, times)
             log_agents(rec, c, every, self.context, self.config.outline_rays)
-            log_sensing(rec, c, every)
+            log_sensing(rec, c, every, self._has_image)
             log_plots(rec, c, every, lambda given: time_index(indexes, steps[given], times[given]))
             log_trails(rec, c, indexes, self.config.trail_every, final, self._trail_ends)
         log_particles(rec, self._particles, indexes)

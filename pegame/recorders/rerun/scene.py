@@ -219,20 +219,25 @@ def log_trails(
         _send(rec, f"world/{name}/trajectory", index, rr.LineStrips3D.columns(strips=segments))
 
 
-def log_sensing(rec: rr.RecordingStream, c: dict[str, np.ndarray], every: list) -> None:
-    """Detection (map point and image box) and estimate; an empty row where there is none."""
+def log_sensing(
+    rec: rr.RecordingStream, c: dict[str, np.ndarray], every: list, images: bool
+) -> None:
+    """Detection (map point, and its box on the camera's image when the simulator renders
+    images: the layout shows the image plane only then) and estimate; an empty row where
+    there is none."""
     seen = np.isfinite(c["det_x"])
     sizes = seen.astype(np.int64)
     where = stack_points(c["det_x"][seen], c["det_y"][seen], Z_MARKER)
     _send(rec, "world/detection", every, rr.Points3D.columns(positions=where).partition(sizes))
-    seen_at = zip(c["confidence"][seen].tolist(), c["depth"][seen].tolist())
-    labels = [f"evader {p:.2f}, {d:.2f} m" for p, d in seen_at]
-    boxes = rr.Boxes2D.columns(
-        centers=np.column_stack([c["box_cx"][seen], c["box_cy"][seen]]),
-        half_sizes=np.column_stack([c["box_hw"][seen], c["box_hh"][seen]]),
-        labels=labels,
-    )
-    _send(rec, "camera/detection", every, boxes.partition(sizes))
+    if images:
+        seen_at = zip(c["confidence"][seen].tolist(), c["depth"][seen].tolist())
+        labels = [f"evader {p:.2f}, {d:.2f} m" for p, d in seen_at]
+        boxes = rr.Boxes2D.columns(
+            centers=np.column_stack([c["box_cx"][seen], c["box_cy"][seen]]),
+            half_sizes=np.column_stack([c["box_hw"][seen], c["box_hh"][seen]]),
+            labels=labels,
+        )
+        _send(rec, "camera/detection", every, boxes.partition(sizes))
     estimated = np.isfinite(c["mean_x"])
     mean = stack_points(c["mean_x"][estimated], c["mean_y"][estimated], Z_MARKER)
     columns = rr.Points3D.columns(positions=mean).partition(estimated.astype(np.int64))
