@@ -150,6 +150,21 @@ def test_a_recording_that_cannot_be_written_fails_its_game(tmp_path, monkeypatch
     assert not [p for p in tmp_path.iterdir() if recording_status(p)]  # no broken file
 
 
+def test_a_layout_file_that_cannot_be_written_fails_its_game(tmp_path, monkeypatch):
+    from pegame.recorders.rerun import blueprint
+
+    def full(path: Path, data: bytes, **options: object) -> None:
+        raise files.write_failed(path, OSError(28, "No space left on device"))
+
+    monkeypatch.setattr(blueprint, "write_atomic", full)
+    cfg = compose(["recorder=rerun", "env=hall", "game.t_max=2", *RANDOM])
+    run_ = job.run_job(cfg, tmp_path)
+    assert run_.failed == [0] and run_.status == 1
+    (failed,) = [e for e in job.read_lines(tmp_path / "results.jsonl") if e["kind"] == "failed"]
+    assert failed["error"].startswith("ResultsWriteError: Could not write to")
+    assert "pegame.rbl" in failed["error"]
+
+
 @pytest.mark.slow
 def test_an_unwritable_run_dir_is_one_message_and_exit_2(tmp_path, mount):
     (tmp_path / "a_file").write_text("")

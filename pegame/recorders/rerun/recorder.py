@@ -167,6 +167,8 @@ class RerunRecorder(Recorder):
             return
         try:
             self._log(tick)
+        except ResultsWriteError:  # the layout file could not be written: as a recording
+            raise
         except Exception as exc:
             self._fail("logging", exc)
 
