@@ -17,7 +17,8 @@ Two implementations give identical crops: :func:`local_crop_reference` in plain 
 and the numba kernels behind :class:`LocalCrop`, which write into a caller's buffer: the
 crop's cells from its lattice (:func:`lattice_crop`, a row term plus a column term per
 cell, whose error bound proves the same cells) and, for a pose whose lattice comes too
-near a cell edge, :func:`_crop`'s division. The batched environments use the same two.
+near a cell edge, :func:`_crop`'s division; :func:`crop_kernel` picks the route, for
+the single game and the batched environments alike.
 The kernels take what they read grouped by meaning (:class:`CropLattice`,
 :class:`CropSamples`, :class:`CropScratch`, and the agent's pose as (x, y, cos, sin) of
 its heading), unpacked once at entry.
@@ -149,8 +150,8 @@ _TABLE_LIMIT = 2**31
 def lattice_crop(lattice: tuple, pose: Heading, out: np.ndarray, at: int, scratch: tuple) -> bool:
     """The crop's cells around the ``pose`` (x, y, cos, sin of the heading theta; map
     frame, m) from the crop's lattice, into out[at:]; returns whether every cell is
-    decided (else out is to be redone by the division: :func:`_crop`, or the
-    batched env's ``_divided_crop``).
+    decided (else out is to be redone by :func:`_crop`'s division, as
+    :func:`crop_kernel` does).
 
     Crop cell (i, j) lies at the grid-frame point (in cells) P + o_j A + o_i B, with
     o = ``centres`` (m, the crop's cell centres along one axis), P = R(-yaw) (x - gx, y - gy) / res and A, B = R(-yaw)
@@ -236,16 +237,28 @@ def bordered_table(pooled: np.ndarray, offsets: np.ndarray, resolution: float) -
     return np.pad(pooled.astype(np.uint8), pad, constant_values=1)
 
 
+@njit(cache=True, inline="always")
+def crop_kernel(
+    lattice: tuple, samples: tuple, scratch: tuple, pose: Heading, out: np.ndarray, at: int
+) -> bool:
+    """:func:`_crop`'s cells around the ``pose`` into out[at:]: from the crop's lattice
+    (:func:`lattice_crop`) when it decides every cell, else by :func:`_crop`'s division;
+    returns whether the division was needed. The one crop of both the single game
+    (:class:`LocalCrop`, :mod:`pegame.observe.features`) and the batched one."""
+    if lattice_crop(lattice, pose, out, at, scratch):
+        return False
+    _, _, frame, _ = lattice
+    _crop(samples, frame, pose, out[at:])
+    return True
+
+
 @njit(cache=True)
 def _crop_fast(
     lattice: tuple, samples: tuple, scratch: tuple, pose: Heading, out: np.ndarray
 ) -> None:
-    """:func:`_crop`'s cells into ``out``: from the crop's lattice (:func:`lattice_crop`)
-    when it decides every cell, else by :func:`_crop`'s division. The structures come as
-    plain tuples (:class:`LocalCrop`)."""
-    if not lattice_crop(lattice, pose, out, 0, scratch):
-        _, _, frame, _ = lattice
-        _crop(samples, frame, pose, out)
+    """:func:`crop_kernel` into ``out``, for :class:`LocalCrop` (the structures as plain
+    tuples)."""
+    crop_kernel(lattice, samples, scratch, pose, out, 0)
 
 
 class LocalCrop:
@@ -266,9 +279,10 @@ class LocalCrop:
             pooled.shape[1],
         )
         self._scratch = CropScratch(np.empty(self.size, dtype=np.int32), np.empty((2, cells)))
-        # The three as plain tuples for the kernel: numba dispatches a NamedTuple argument
-        # in about 0.6 us, a plain tuple in 0.05-0.13 us, and a crop takes 2 us.
-        self._structures = (tuple(self._lattice), tuple(self._samples), tuple(self._scratch))
+        #: (lattice, samples, scratch) as plain tuples for the kernels (crop_kernel): numba
+        #: dispatches a NamedTuple argument in about 0.6 us, a plain tuple in 0.05-0.13
+        #: us, and a crop takes 2 us.
+        self.structures = (tuple(self._lattice), tuple(self._samples), tuple(self._scratch))
 
     def __call__(
         self, x: float, y: float, theta: float, out: np.ndarray | None = None
@@ -279,5 +293,5 @@ class LocalCrop:
         if out is None:
             out = np.empty(self.size, dtype=np.float32)
         pose = (float(x), float(y), math.cos(theta), math.sin(theta))
-        _crop_fast(*self._structures, pose, out)
+        _crop_fast(*self.structures, pose, out)
         return out

@@ -31,6 +31,10 @@ Evader (:class:`EvaderFeatures`), which is told the pursuer's pose as in the pap
 - ``relative`` (4): the pursuer's position in the evader's frame / D (x, y) and
   cos, sin of the pursuer's heading relative to the evader's;
 - ``crop`` (cells^2).
+
+The float operations are numba kernels of one game in :mod:`pegame.observe.features`
+(one call per vector), shared with the batched environments (:mod:`pegame.vector.features`);
+the belief part, which only the single game has, is computed here.
 """
 
 from __future__ import annotations
@@ -44,10 +48,9 @@ import numpy as np
 from pegame.api import Context, EvaderObservation, PursuerObservation
 from pegame.errors import require
 from pegame.observe.crop import LocalCrop
-from pegame.types import Belief, Detection, Pose, wrap_angle
-
-#: s; detection ages are divided by this and capped at 1
-AGE_SCALE = 10.0
+from pegame.observe.features import AGE_SCALE as AGE_SCALE
+from pegame.observe.features import evader_observation, extent_numbers, pursuer_observation
+from pegame.types import Belief, Detection, Pose
 
 
 @dataclass(frozen=True)
@@ -88,10 +91,8 @@ class _Features:
     ) -> None:
         self.context = context
         self.settings = settings
-        x0, x1, y0, y1 = context.grid.extent
-        self._x0, self._y0 = x0, y0
-        self._sx, self._sy = 2.0 / (x1 - x0), 2.0 / (y1 - y0)
-        self._diagonal = math.hypot(x1 - x0, y1 - y0)
+        self._extent = extent_numbers(context.grid)
+        self._diagonal = float(self._extent[4])
         parts = [*parts, ("crop", settings.crop_cells**2, 0.0, 1.0)]
         self.layout: dict[str, slice] = {}
         low, high, start = [], [], 0
@@ -102,19 +103,14 @@ class _Features:
             start += size
         self.size = start
         self._crop_at = self.layout["crop"].start
-        self._local_crop = LocalCrop(context.grid, settings.crop_cells, settings.crop_resolution)
+        crop = LocalCrop(context.grid, settings.crop_cells, settings.crop_resolution)
+        self._crop = crop.structures
         self.low = np.array(low, dtype=np.float32)
         self.high = np.array(high, dtype=np.float32)
 
-    def _pose(self, out: np.ndarray, at: int, pose: Pose) -> None:
-        """Write the normalised map-frame pose (x_n, y_n, cos, sin) into out[at:at + 4]."""
-        out[at] = min(1.0, max(-1.0, (pose.x - self._x0) * self._sx - 1.0))
-        out[at + 1] = min(1.0, max(-1.0, (pose.y - self._y0) * self._sy - 1.0))
-        out[at + 2] = math.cos(pose.theta)
-        out[at + 3] = math.sin(pose.theta)
 
-    def _crop(self, out: np.ndarray, pose: Pose) -> None:
-        self._local_crop(pose.x, pose.y, pose.theta, out[self._crop_at :])
+#: the kernels' (time, x, y) of the last detection before there is one (not read)
+_NOWHERE = (0.0, 0.0, 0.0)
 
 
 class PursuerFeatures(_Features):
@@ -126,6 +122,7 @@ class PursuerFeatures(_Features):
         if settings.belief:
             parts.append(("belief", 4, -1.0, 1.0))
         super().__init__(context, settings, parts)
+        self._far = float(context.camera.far)
         self.reset()
 
     def reset(self) -> None:
@@ -137,25 +134,28 @@ class PursuerFeatures(_Features):
         """Record this control tick's detection (or its absence) at ``time`` (s)."""
         self._now = detection is not None
         if detection is not None:
-            self._last = (time, float(detection.position[0]), float(detection.position[1]))
+            position = detection.position
+            self._last = (float(time), float(position[0]), float(position[1]))
 
     def build(self, time: float, pose: Pose, belief: Belief) -> np.ndarray:
         """The vector at ``time`` (s) for the pursuer at map-frame ``pose``; ``belief`` is
         read only with ``belief=True``. A new float32 array each call."""
         out = np.empty(self.size, dtype=np.float32)
-        self._pose(out, 0, pose)
-        out[4] = float(self._now)
-        if self._last is None:
-            out[5:8] = (1.0, 0.0, 1.0)
-        else:
-            seen_at, x, y = self._last
-            dx, dy = x - pose.x, y - pose.y
-            out[5] = min(1.0, math.hypot(dx, dy) / self.context.camera.far)
-            out[6] = wrap_angle(math.atan2(dy, dx) - pose.theta) / math.pi
-            out[7] = min(1.0, (time - seen_at) / AGE_SCALE)
+        last = self._last
+        pursuer_observation(
+            self._extent,
+            self._crop,
+            (float(pose.x), float(pose.y), float(pose.theta)),
+            self._now,
+            last is not None,
+            _NOWHERE if last is None else last,
+            float(time),
+            self._far,
+            out,
+            self._crop_at,
+        )
         if self.settings.belief:
             self._belief(out[8:12], pose, belief)
-        self._crop(out, pose)
         return out
 
     def update(self, observation: PursuerObservation) -> None:
@@ -205,16 +205,14 @@ class EvaderFeatures(_Features):
         """The vector for the evader at map-frame ``pose`` and the pursuer at ``pursuer``.
         A new float32 array each call."""
         out = np.empty(self.size, dtype=np.float32)
-        self._pose(out, 0, pose)
-        self._pose(out, 4, pursuer)
-        dx, dy = pursuer.x - pose.x, pursuer.y - pose.y
-        c, s = math.cos(pose.theta), math.sin(pose.theta)
-        d = self._diagonal
-        out[8] = min(1.0, max(-1.0, (c * dx + s * dy) / d))
-        out[9] = min(1.0, max(-1.0, (-s * dx + c * dy) / d))
-        out[10] = math.cos(pursuer.theta - pose.theta)
-        out[11] = math.sin(pursuer.theta - pose.theta)
-        self._crop(out, pose)
+        evader_observation(
+            self._extent,
+            self._crop,
+            (float(pose.x), float(pose.y), float(pose.theta)),
+            (float(pursuer.x), float(pursuer.y), float(pursuer.theta)),
+            out,
+            self._crop_at,
+        )
         return out
 
     def __call__(self, observation: EvaderObservation) -> np.ndarray:

@@ -5,7 +5,8 @@
 - :mod:`pegame.vector.kernels`: the tick of every game (the grid simulator's own move
   kernel, the measures) as numba kernels, parallel over games; :mod:`pegame.vector.camera`
   (detector, ground truth: the visibility and detector plugins' own kernels) and
-  :mod:`pegame.vector.features` (observations) per game; :mod:`pegame.vector.state` the
+  :mod:`pegame.vector.features` (observations: :mod:`pegame.observe.features`' own
+  kernels) per game; :mod:`pegame.vector.state` the
   arrays and numbers they take;
 - :mod:`pegame.vector.opponents`: the scripted opponent of a learner;
 - :mod:`pegame.vector.metrics`: the measures kept as running sums.

@@ -71,6 +71,7 @@ from pegame.game import STREAMS, Scenario, spawn
 from pegame.grid import OccupancyGrid
 from pegame.navigation import shared_inflation
 from pegame.observe.crop import LocalCrop
+from pegame.observe.features import extent_numbers
 from pegame.observe.observations import EvaderFeatures, PursuerFeatures
 from pegame.observe.settings import EnvSettings
 from pegame.sims.grid import GridSimulator, body_rows
@@ -275,7 +276,6 @@ _NO_TABLE = np.zeros((1, 1, 2))
 
 def _world(grid: OccupancyGrid, context: Context, settings: EnvSettings) -> World:
     crop = LocalCrop(grid, settings.crop_cells, settings.crop_resolution)
-    x0, x1, y0, y1 = grid.extent
     masks = np.stack(
         [
             shared_inflation(grid, context.pursuer.radius),
@@ -292,7 +292,7 @@ def _world(grid: OccupancyGrid, context: Context, settings: EnvSettings) -> Worl
         crop._lattice.table,
         crop._lattice.centres,
         sight_values,
-        np.array([x0, y0, 2.0 / (x1 - x0), 2.0 / (y1 - y0), math.hypot(x1 - x0, y1 - y0)]),
+        extent_numbers(grid),
     )
 
 

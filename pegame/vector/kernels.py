@@ -14,7 +14,8 @@ compares them step by step):
 - :func:`tally` accumulates :class:`pegame.metrics.TrackingMetrics` as running sums
   (:mod:`pegame.vector.metrics` turns them into its summary);
 - :func:`play` plays ticks in the loop's order (:mod:`pegame.vector.game` lays the
-  correspondence out); :mod:`pegame.vector.features` builds the observations.
+  correspondence out); :mod:`pegame.vector.features` builds the observations with
+  :mod:`pegame.observe.features`' kernels.
 """
 
 from __future__ import annotations

@@ -81,7 +81,8 @@ class World(NamedTuple):
     (m; crop_x and crop_y are their grid); sight_values: bool (1 + H * W,): True (off
     the grid), then ``blocked`` flat, the line of sight's look-up table (``frame`` and
     it: :func:`pegame.visibility.sight.sight_tables`);
-    extent: (x0, y0, 2 / width, 2 / height, diagonal) of the observations' normalisation.
+    extent: (x0, y0, 2 / width, 2 / height, diagonal) of the observations' normalisation
+    (:func:`pegame.observe.features.extent_numbers`).
     """
 
     blocked: np.ndarray
