@@ -28,7 +28,7 @@ features.remember
 and ``TickLoop.start`` (spawn, plugin resets, sense tick 0) is :meth:`reset_games`. The
 kernels play every game's tick in one call (:func:`pegame.vector.kernels.play`, parallel
 over games from ``PARALLEL_GAMES`` games on: below, starting numba's threads costs more
-than it saves). ``tests/test_vector_env.py`` plays the batched and the single env side
+than it saves). ``tests/envs/test_vector.py`` plays the batched and the single env side
 by side, through autoresets and with each opponent, which keeps the two orders the same.
 
 Why a mirror and not the loop itself: ``TickLoop.advance`` drives one game's plugin

@@ -4,7 +4,7 @@ Each kernel loops over the games with ``prange``, from PARALLEL_GAMES games on o
 thread pool (across cores: ``NUMBA_NUM_THREADS`` sets how many), below on one thread
 (:func:`threaded`); inside a game the work
 is the single game's, in the same order and with the same float operations, so a game
-played here is the game the plain-Python code plays (``tests/test_vector_env.py``
+played here is the game the plain-Python code plays (``tests/envs/test_vector.py``
 compares them step by step):
 
 - :func:`pegame.sims.grid.move` is the grid simulator's own move kernel (saturation,
