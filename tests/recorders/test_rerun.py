@@ -594,3 +594,19 @@ def test_detection_boxes_are_logged_on_the_image_plane_only_when_there_are_image
     assert "/camera/detection" not in grid and "/world/detection" in grid
     assert images["/camera/detection"] == list(range(6))
     assert images["/camera/image"] == [0]  # image_every (10) ticks
+
+
+def test_particle_shades_read_only_the_held_part_of_a_reused_buffer():
+    import warnings
+
+    from pegame.recorders.rerun.columns import ParticleRows
+
+    rows = ParticleRows(2, 10, 0.02)
+    rows.weights[:] = 3e38  # what a reused buffer may hold past a row's particles
+    particles = np.array([[1.0, 2.0, 0.0], [3.0, 4.0, 0.0]])
+    rows.add(0, 0.0, particles, np.array([1e-30, 0.5e-30]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow from the entries past the row
+        _, _, positions, sizes, shades, counts = rows.take()
+    assert sizes.tolist() == [2] and counts.tolist() == [2]
+    assert shades.tolist() == [255, 128] and positions[:, :2].tolist() == [[1, 2], [3, 4]]

@@ -249,9 +249,11 @@ class ParticleRows:
         sizes, weights = self.sizes[:n].copy(), self.weights[:n]
         held = np.arange(self.limit) < sizes[:, None]
         unknown = held & np.isnan(weights)
-        top = np.max(np.where(held & ~unknown, weights, 0.0), axis=1, keepdims=True)
+        # Only the held entries: the rest of a row is whatever the buffer held before.
+        known = np.where(held & ~unknown, weights, 0.0)
+        top = np.max(known, axis=1, keepdims=True)
         scale = np.divide(255.0, top, out=np.zeros_like(top), where=top > 0)
-        shades = np.clip(np.where(unknown, 0.0, weights) * scale + 0.5, 0, 255).astype(np.uint8)
+        shades = np.clip(known * scale + 0.5, 0, 255).astype(np.uint8)
         shades[unknown] = 128
         first = shades[:, :1]
         uniform = np.all((shades == first) | ~held, axis=1) & (sizes > 0)
