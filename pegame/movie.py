@@ -58,7 +58,7 @@ def trajectory_game(job_dir: Path) -> RecordedGame:
     from pegame.grid import load_map
     from pegame.recorders.rerun import RerunRecorder
     from pegame.types import Camera
-    from pegame.visibility.outlines import visibility_outlines
+    from pegame.visibility.outlines import drawn_outlines
 
     table, config_file = job_dir / "trajectory.csv", job_dir / ".hydra" / "config.yaml"
     if not table.is_file() or not config_file.is_file():
@@ -93,7 +93,10 @@ def trajectory_game(job_dir: Path) -> RecordedGame:
     pursuer, evader = poses["pursuer"][0], poses["evader"][0]
     camera = Camera(**plain(cfg.camera))
     rays = int(cfg.recorder.get("outline_rays", RerunRecorder.Config.outline_rays))
-    outlines = visibility_outlines(grid, pursuer[:, 0], pursuer[:, 1], pursuer[:, 2], camera, rays)
+    points, lengths = drawn_outlines(
+        grid, pursuer[:, 0], pursuer[:, 1], pursuer[:, 2], camera, rays
+    )
+    outlines = np.split(points[:, :2].astype(float), np.cumsum(lengths)[:-1])
     nothing = np.full(len(rows), np.nan)
     return RecordedGame(
         grid=grid,
@@ -113,7 +116,7 @@ def trajectory_game(job_dir: Path) -> RecordedGame:
         estimate_error=nothing,
         n_eff=nothing.copy(),
         means=np.full((len(rows), 2), np.nan),
-        outlines=[[outline[:, :2].astype(float)] for outline in outlines],
+        outlines=[[outline] for outline in outlines],
         particles=[np.empty((0, 2))] * len(rows),
     )
 

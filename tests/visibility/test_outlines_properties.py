@@ -15,7 +15,12 @@ from hypothesis.extra.numpy import arrays
 
 from pegame.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from pegame.types import Camera
-from pegame.visibility.outlines import NEAR_ARC_POINTS, visibility_outlines
+from pegame.visibility.outlines import (
+    NEAR_ARC_POINTS,
+    simplify_outlines,
+    simplify_reference,
+    visibility_outlines,
+)
 
 Poses = tuple[list[float], list[float], list[float]]
 
@@ -74,3 +79,38 @@ def test_more_obstacles_never_lengthen_a_ray(
     ends = [visibility_outlines(g, xs, ys, thetas, camera, rays) for g in (grid, walled)]
     before, after = (np.hypot(e[:, :rays, 0] - np.c_[xs], e[:, :rays, 1] - np.c_[ys]) for e in ends)
     assert np.all(after <= before)
+
+
+def _segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Distance (m) in the plane from ``point`` to the segment a-b (plain numpy)."""
+    d, p = b[:2] - a[:2], point[:2] - a[:2]
+    length = float(d @ d)
+    t = 0.0 if length == 0.0 else min(1.0, max(0.0, float(p @ d) / length))
+    return float(np.hypot(*(p - t * d)))
+
+
+@settings(max_examples=150)
+@given(scenes(), st.floats(0.0, 0.2))
+def test_simplified_outlines_keep_the_ends_and_drop_only_vertices_near_the_drawn_line(
+    scene: tuple[OccupancyGrid, Poses, Camera, int], tolerance: float
+) -> None:
+    grid, (xs, ys, thetas), camera, rays = scene
+    outlines = visibility_outlines(grid, xs, ys, thetas, camera, rays)
+    points, lengths = simplify_outlines(outlines, tolerance)
+    plain = simplify_reference(outlines, tolerance)
+    assert np.array_equal(points, plain[0]) and np.array_equal(lengths, plain[1])
+    assert lengths.sum() == len(points)
+    for polygon, kept in zip(outlines, np.split(points, np.cumsum(lengths)[:-1])):
+        # the kept vertices are the polygon's, in order, with its first and last
+        assert np.array_equal(kept[0], polygon[0]) and np.array_equal(kept[-1], polygon[-1])
+        indices = [0]
+        for vertex in kept[1:-1]:  # each found after the one before it
+            later = np.flatnonzero((polygon[indices[-1] + 1 :] == vertex).all(axis=1))
+            assert later.size, "a kept vertex is the polygon's, in order"
+            indices.append(indices[-1] + 1 + int(later[0]))
+        indices.append(len(polygon) - 1)
+        assert indices == sorted(set(indices))
+        for start, stop in zip(indices, indices[1:]):
+            for dropped in polygon[start + 1 : stop]:
+                gap = _segment_distance(dropped, polygon[start], polygon[stop])
+                assert gap <= tolerance + 1e-5

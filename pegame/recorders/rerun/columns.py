@@ -175,10 +175,17 @@ def time_index(cache: dict, steps: np.ndarray, times: np.ndarray) -> list:
     return cache[key]
 
 
-def strips_array(strips: np.ndarray | Sequence[np.ndarray]) -> pa.ListArray:
-    """LineStrip3D arrow array of float32 strips: a list of (K, 3) arrays or an (n, K, 3)
-    array. Built in one go: rerun-sdk's own conversion loops over the strips in Python."""
-    if isinstance(strips, np.ndarray):
+def strips_array(
+    strips: np.ndarray | Sequence[np.ndarray], lengths: np.ndarray | None = None
+) -> pa.ListArray:
+    """LineStrip3D arrow array of float32 strips: a list of (K, 3) arrays, an (n, K, 3)
+    array, or (M, 3) points one strip after another with the strips' ``lengths`` (n,).
+    Built in one go: rerun-sdk's own conversion loops over the strips in Python."""
+    if lengths is not None:
+        flat = np.asarray(strips)
+        offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
+        offsets[1:] = np.cumsum(lengths)
+    elif isinstance(strips, np.ndarray):
         n, k = strips.shape[:2]
         flat = strips.reshape(n * k, 3)
         offsets = np.arange(0, (n + 1) * k, k, dtype=np.int32) if k else np.zeros(n + 1, np.int32)

@@ -90,7 +90,7 @@ class RerunRecorder(Recorder):
         flush_every: int = 1000  # control ticks buffered per send (sends cost a fixed time each; a 90 s game is one)
         live_flush_every: int = 10  # the same with spawn=true, so that the live viewer keeps up
         max_particles: int = (
-            100  # particles logged per logged tick, an evenly strided subsample (0: none)
+            64  # particles logged per logged tick, an evenly strided subsample (0: none)
         )
         particles_every: int = (
             2  # control ticks between logged particle clouds (the viewer holds the last)

@@ -36,7 +36,7 @@ from pegame.recorders.rerun.columns import (
 )
 from pegame.types import Camera, Plan, Pose
 from pegame.visibility import fov_wedge
-from pegame.visibility.outlines import visibility_outlines
+from pegame.visibility.outlines import drawn_outlines
 
 PURSUER = (220, 40, 40, 255)
 EVADER = (30, 160, 60, 255)
@@ -184,12 +184,11 @@ def log_agents(
         translation=stack_points(c["px"], c["py"], 0.0), quaternion=rotation
     )
     _send(rec, "world/pursuer/fov", every, wedge)
-    outlines = visibility_outlines(
+    points, lengths = drawn_outlines(
         context.grid, c["px"], c["py"], c["ptheta"], context.camera, outline_rays, Z_REGION
     )
-    _send(
-        rec, "world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips_array(outlines))
-    )
+    strips = strips_array(points, lengths)
+    _send(rec, "world/pursuer/visible", every, rr.LineStrips3D.columns(strips=strips))
 
 
 def log_trails(
