@@ -101,13 +101,13 @@ def test_a_full_disk_fails_the_game_it_cannot_record_and_leaves_no_broken_record
     tmp_path, mount, size
 ):
     # 2 MB: rerun's file sink wrote a truncated game_2.rrd that was called complete, exit 0;
-    # 1.5 MB: the second game hung on rerun's recording stream until killed. A 45 s game
-    # on brick records about 0.9 MB: the three games cannot all fit.
+    # 1.5 MB: the second game hung on rerun's recording stream until killed. A 90 s game
+    # on brick records about 1 MB: the three games cannot all fit.
     out = mount(f"size={size}") / "run"
     status, err = run(
         tmp_path,
         "env=brick",
-        "game.t_max=45",
+        "game.t_max=90",
         "game.trials=3",
         "recorder=rerun",
         f"hydra.run.dir={out}",

@@ -190,10 +190,10 @@ def strips_array(
         flat = strips.reshape(n * k, 3)
         offsets = np.arange(0, (n + 1) * k, k, dtype=np.int32) if k else np.zeros(n + 1, np.int32)
     else:
-        lengths = [len(strip) for strip in strips]
-        flat = np.concatenate(strips) if lengths else np.zeros((0, 3), np.float32)
-        offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
-        offsets[1:] = np.cumsum(lengths)
+        sizes = [len(strip) for strip in strips]
+        flat = np.concatenate(strips) if sizes else np.zeros((0, 3), np.float32)
+        offsets = np.zeros(len(sizes) + 1, dtype=np.int32)
+        offsets[1:] = np.cumsum(sizes)
     points = rr.encodings.Vec3DBatch(flat).as_arrow_array()
     strip_type = pa.list_(pa.field("item", points.type, nullable=False))
     return pa.ListArray.from_arrays(pa.array(offsets), points, type=strip_type)
