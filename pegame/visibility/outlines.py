@@ -163,11 +163,14 @@ def simplify_reference(outlines: np.ndarray, tolerance: float) -> tuple[np.ndarr
         out[n] = outlines[p, 0]
         n += 1
         for i in range(1, size - 1):
-            ax, ay = outlines[p, kept, 0], outlines[p, kept, 1]
-            dx, dy = outlines[p, i + 1, 0] - ax, outlines[p, i + 1, 1] - ay
+            # In float64, so that the compiled kernel and this plain code round alike
+            # (numba's float() of a float32 stays float32).
+            f64 = np.float64
+            ax, ay = f64(outlines[p, kept, 0]), f64(outlines[p, kept, 1])
+            dx, dy = f64(outlines[p, i + 1, 0]) - ax, f64(outlines[p, i + 1, 1]) - ay
             squared = dx * dx + dy * dy
             for j in range(kept + 1, i + 1):
-                px, py = outlines[p, j, 0] - ax, outlines[p, j, 1] - ay
+                px, py = f64(outlines[p, j, 0]) - ax, f64(outlines[p, j, 1]) - ay
                 t = 0.0 if squared == 0.0 else min(1.0, max(0.0, (px * dx + py * dy) / squared))
                 ex, ey = px - t * dx, py - t * dy
                 if ex * ex + ey * ey > tolerance * tolerance:
