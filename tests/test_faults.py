@@ -134,11 +134,11 @@ def test_a_full_disk_fails_the_game_it_cannot_record_and_leaves_no_broken_record
 def test_a_recording_that_cannot_be_written_fails_its_game(tmp_path, monkeypatch, caplog):
     real_open = os.open
 
-    def full_for_recordings(path: str, flags: int, *args: int) -> int:
+    def full_for_recordings(path: str, flags: int, *args: int, **options: int) -> int:
         # a recording's partial file opens /dev/full: its write fails with ENOSPC
         if str(path).endswith(".rrd.partial"):
             return real_open("/dev/full", os.O_WRONLY)
-        return real_open(path, flags, *args)
+        return real_open(path, flags, *args, **options)
 
     monkeypatch.setattr(files.os, "open", full_for_recordings)
     cfg = compose(["recorder=rerun", "env=hall", "game.t_max=2", "game.trials=2", *RANDOM])
