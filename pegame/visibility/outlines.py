@@ -187,9 +187,12 @@ def simplify_reference(outlines: np.ndarray, tolerance: float) -> tuple[np.ndarr
 _simplify_kernel = njit(cache=True)(simplify_reference)
 
 
-def simplify_outlines(outlines: np.ndarray, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`simplify_reference`, compiled."""
-    return _simplify_kernel(outlines, float(tolerance))
+def simplify_outlines(
+    outlines: np.ndarray, tolerance: float, compiled: bool = True
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`simplify_reference`, compiled (compiled=False: the plain code itself)."""
+    simplify = _simplify_kernel if compiled else simplify_reference
+    return simplify(outlines, float(tolerance))
 
 
 def drawn_outlines(

@@ -18,7 +18,6 @@ from pegame.types import Camera
 from pegame.visibility.outlines import (
     NEAR_ARC_POINTS,
     simplify_outlines,
-    simplify_reference,
     visibility_outlines,
 )
 
@@ -97,7 +96,7 @@ def test_simplified_outlines_keep_the_ends_and_drop_only_vertices_near_the_drawn
     grid, (xs, ys, thetas), camera, rays = scene
     outlines = visibility_outlines(grid, xs, ys, thetas, camera, rays)
     points, lengths = simplify_outlines(outlines, tolerance)
-    plain = simplify_reference(outlines, tolerance)
+    plain = simplify_outlines(outlines, tolerance, compiled=False)
     assert np.array_equal(points, plain[0]) and np.array_equal(lengths, plain[1])
     assert lengths.sum() == len(points)
     for polygon, kept in zip(outlines, np.split(points, np.cumsum(lengths)[:-1])):
