@@ -54,6 +54,9 @@ from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
 from pegame.navigation import Planner
 from pegame.types import Camera, Pose, Region
 from pegame.visibility import VisibilityRegion, visibility_region
+from pegame.visibility.lazy import Rays, Sight, rays_reaching
+from pegame.visibility.rays import directions, ray_tables
+from pegame.visibility.region import march_ray
 
 DISTANCES = ("euclidean", "geodesic")
 
@@ -240,30 +243,224 @@ def _best_candidate(
     distance fields ``costs.effort`` and ``costs.dist`` (m) the costs come from them, else
     from Euclidean distances computed as :meth:`EscapeSearch.costs` does.
     """
-    starts, rows, cols, frame, grid_width = cells
     window, top, left = exposed
-    agents, effort, dist = costs
     best_cell, best_cost = best
-    ex, ey, px, py = agents
-    height, width = window.shape
     for t in tiles:
         if bounds[t] > best_cost * (1.0 + BOUND_SLACK):
             return best_cell, best_cost, True
-        for k in range(starts[t], starts[t + 1]):
-            row, col = rows[k] - top, cols[k] - left
-            if 0 <= row < height and 0 <= col < width and window[row, col]:
-                continue
-            cell = rows[k] * grid_width + cols[k]
-            if effort.size:
-                e, d = effort[cell], dist[cell]
-            else:
-                x, y = _cell_centre(rows[k], cols[k], frame)
-                ax, ay, bx, by = x - ex, y - ey, x - px, y - py
-                e, d = math.sqrt(ax * ax + ay * ay), math.sqrt(bx * bx + by * by)
-            cost = e / d if d > 0.0 else np.inf
-            if cost < best_cost or (cost == best_cost and (best_cell < 0 or cell < best_cell)):
-                best_cell, best_cost = cell, cost
+        best_cell, best_cost = _score_tile(t, cells, window, top, left, costs, best_cell, best_cost)
     return best_cell, best_cost, False
+
+
+@njit(cache=True, inline="always")
+def _score_tile(
+    t: int,
+    cells: tuple,
+    window: np.ndarray,
+    top: int,
+    left: int,
+    costs: tuple,
+    best_cell: int,
+    best_cost: float,
+) -> tuple[int, float]:
+    """The argmin of the (flat cell, cost) ``best_cell, best_cost`` and tile ``t``'s
+    ``cells`` outside the bool ``window`` placed at (top, left) (cells off it are
+    outside): lowest cost, then lowest flat index."""
+    starts, rows, cols, frame, grid_width = cells
+    agents, effort, dist = costs
+    ex, ey, px, py = agents
+    height, width = window.shape
+    for k in range(starts[t], starts[t + 1]):
+        row, col = rows[k] - top, cols[k] - left
+        if 0 <= row < height and 0 <= col < width and window[row, col]:
+            continue
+        cell = rows[k] * grid_width + cols[k]
+        if effort.size:
+            e, d = effort[cell], dist[cell]
+        else:
+            x, y = _cell_centre(rows[k], cols[k], frame)
+            ax, ay, bx, by = x - ex, y - ey, x - px, y - py
+            e, d = math.sqrt(ax * ax + ay * ay), math.sqrt(bx * bx + by * by)
+        cost = e / d if d > 0.0 else np.inf
+        if cost < best_cost or (cost == best_cost and (best_cell < 0 or cell < best_cell)):
+            best_cell, best_cost = cell, cost
+    return best_cell, best_cost
+
+
+@njit(cache=True)
+def escape_goal(
+    cells: tuple,
+    boxes: np.ndarray,
+    sight: tuple,
+    rays: tuple,
+    half_widths: np.ndarray,
+    agents: tuple,
+    scratch: tuple,
+) -> tuple[int, float]:
+    """Algorithm 2's argmin (flat cell, cost; (-1, inf) without a candidate) for the
+    evader and the pursuer at ``agents`` (ex, ey, px, py, pursuer heading) (m, rad), over
+    a component's tiled ``cells`` (:class:`TiledCells`) with tile ``boxes`` (T, 4),
+    computing the pursuer's visibility region only where the search looks: the goal and
+    cost of :meth:`EscapeSearch.escape` without its count and sample of the candidates.
+
+    Tiles are scored in increasing bound from a heap, as far as :func:`_best_candidate`
+    scores them (its argmin does not depend on the order of equal bounds: every tile whose
+    bound is within the slack of the final cost is scored). For a tile, V grown by the
+    hide margin (``half_widths``, :func:`disc_half_widths`) is only needed on its cells,
+    so V is needed on the tile's block grown by the margin: the rays that can reach that
+    block as far as they can reach it (:func:`pegame.visibility.lazy.rays_reaching`),
+    marched as the whole region marches them (:func:`pegame.visibility.region.march_ray`)
+    and kept for later tiles. A ray marks the same cells whichever others are marched,
+    so on the block the marks are the whole region's. A tile whose block no ray reaches,
+    or that holds no mark, has no cell in grown V.
+
+    sight: (blocked (H, W), kernel_frame, grid yaw) as :class:`pegame.visibility.lazy.Sight`;
+    rays: the camera's :class:`pegame.visibility.lazy.Rays`; scratch: (bool (H, W) all
+    False, int64 (rays,) all 0, int64 (samples,)), left as found. A ray is marched in
+    pieces, each sample once: its scratch entry holds the samples marched, or -1 - the
+    index of the blocked sample that stopped it.
+    """
+    blocked, frame, yaw = sight
+    angles, distances, first = rays[0], rays[1], rays[2]
+    mask, marched, ray_cells = scratch
+    ex, ey, px, py, heading = agents
+    eye = (px, py, heading)
+    costs = ((ex, ey, px, py), np.zeros(0), np.zeros(0))
+    bounds = _tile_bounds(boxes, ex, ey, px, py)
+    heap = _tile_heap(bounds)
+    size = heap.size
+    reach = half_widths.size - 1
+    height, width = blocked.shape
+    window = np.zeros((TILE, TILE), dtype=np.bool_)
+    counts = np.empty((TILE + 2 * reach, TILE + 2 * reach + 1), dtype=np.int64)
+    cos_a, sin_a = np.zeros(0), np.zeros(0)
+    marked = (height, 0, width, 0)  # the rows and columns marks were made in
+    lo_ray, hi_ray = angles.size, 0  # the rays marched
+    best_cell, best_cost = -1, np.inf
+    starts, rows, cols = cells[0], cells[1], cells[2]
+    while size > 0:
+        t = heap[0]
+        if bounds[t] > best_cost * (1.0 + BOUND_SLACK):
+            break
+        size = _heap_pop(heap, size, bounds)
+        top = rows[starts[t]] // TILE * TILE
+        left = cols[starts[t]] // TILE * TILE
+        block = (
+            max(top - reach, 0),
+            min(top + TILE - 1 + reach, height - 1),
+            max(left - reach, 0),
+            min(left + TILE - 1 + reach, width - 1),
+        )
+        i0, i1, samples = rays_reaching(rays, eye, frame, yaw, block)
+        seen = i1 > i0 and samples > first
+        if seen:
+            if cos_a.size == 0:
+                cos_a, sin_a = directions(heading, angles, 0, angles.size)
+            for i in range(i0, i1):
+                done = marched[i]  # the samples marched (or -1 - the blocked one's index)
+                if 0 <= done < samples:
+                    ray = (cos_a[i], sin_a[i])
+                    ahead = distances[done:samples]
+                    stop, marked = march_ray(
+                        blocked,
+                        ray,
+                        ahead,
+                        max(first - done, 0),
+                        px,
+                        py,
+                        frame,
+                        ray_cells,
+                        mask,
+                        marked,
+                    )
+                    marched[i] = samples if stop == ahead.size else -1 - (done + stop)
+            lo_ray, hi_ray = min(lo_ray, i0), max(hi_ray, i1)
+        # No mark near the tile: no cell of it lies in grown V.
+        r0, r1, c0, c1 = marked
+        seen = seen and r0 <= block[1] and block[0] < r1 and c0 <= block[3] and block[2] < c1
+        if seen:
+            _grown_tile(mask, top, left, half_widths, counts, window)
+        else:
+            window[:] = False
+        best_cell, best_cost = _score_tile(t, cells, window, top, left, costs, best_cell, best_cost)
+    r0, r1, c0, c1 = marked
+    if r1 > r0:
+        mask[r0:r1, c0:c1] = False
+    if hi_ray > lo_ray:
+        marched[lo_ray:hi_ray] = 0
+    return best_cell, best_cost
+
+
+@njit(cache=True)
+def _grown_tile(
+    mask: np.ndarray,
+    top: int,
+    left: int,
+    half_widths: np.ndarray,
+    counts: np.ndarray,
+    window: np.ndarray,
+) -> None:
+    """Set the bool (TILE, TILE) ``window`` to the cells of the tile at (top, left) that
+    :func:`_grow` marks from the True cells of ``mask`` (those within the disc of
+    ``half_widths`` of one, the disc being symmetric), by running counts of the marks
+    along the rows about the tile (``counts``: int scratch (TILE + 2 R, TILE + 2 R + 1),
+    R the disc's reach)."""
+    reach = half_widths.size - 1
+    height, width = mask.shape
+    for i in range(TILE + 2 * reach):
+        row = top - reach + i
+        total = 0
+        counts[i, 0] = 0
+        for j in range(TILE + 2 * reach):
+            col = left - reach + j
+            if 0 <= row < height and 0 <= col < width and mask[row, col]:
+                total += 1
+            counts[i, j + 1] = total
+    for r in range(TILE):
+        for c in range(TILE):
+            near = False
+            for offset in range(-reach, reach + 1):
+                half = half_widths[abs(offset)]
+                i = r + reach + offset
+                # columns c - half .. c + half, at j = c + reach - half .. c + reach + half
+                if counts[i, c + reach + half + 1] > counts[i, c + reach - half]:
+                    near = True
+                    break
+            window[r, c] = near
+
+
+@njit(cache=True)
+def _tile_heap(bounds: np.ndarray) -> np.ndarray:
+    """The tiles 0..T-1 as a binary min-heap on ``bounds`` (T,)."""
+    heap = np.arange(bounds.size)
+    for start in range(bounds.size // 2 - 1, -1, -1):
+        _sift_down(heap, start, bounds.size, bounds)
+    return heap
+
+
+@njit(cache=True, inline="always")
+def _heap_pop(heap: np.ndarray, size: int, bounds: np.ndarray) -> int:
+    """Remove the root of the min-heap ``heap[:size]`` on ``bounds``; the new size."""
+    size -= 1
+    heap[0] = heap[size]
+    _sift_down(heap, 0, size, bounds)
+    return size
+
+
+@njit(cache=True, inline="always")
+def _sift_down(heap: np.ndarray, slot: int, size: int, bounds: np.ndarray) -> None:
+    item = heap[slot]
+    while True:
+        child = 2 * slot + 1
+        if child >= size:
+            break
+        if child + 1 < size and bounds[heap[child + 1]] < bounds[heap[child]]:
+            child += 1
+        if bounds[heap[child]] >= bounds[item]:
+            break
+        heap[slot] = heap[child]
+        slot = child
+    heap[slot] = item
 
 
 @njit(cache=True)
@@ -391,6 +588,7 @@ class EscapeSearch:
         self._strided = stride[: grid.height, None] & stride[None, : grid.width]
         self._half_widths = disc_half_widths(hide_margin, grid.resolution)
         self._component: _Component | None = None
+        self._scratch: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def escape(self, me: Pose, pursuer: Pose, visible: Region | None = None) -> Escape:
         """Algorithm 2's argmin for the evader at ``me`` and the pursuer at ``pursuer``:
@@ -432,6 +630,58 @@ class EscapeSearch:
         step = _sample_step(count, MAX_RECORDED_CANDIDATES)
         sample = component.cells[_sample_positions(skipped, count, step)].astype(np.int64)
         return Escape(int(cell), float(cost), count, sample)
+
+    def goal(self, me: Pose, pursuer: Pose) -> tuple[int, float]:
+        """:meth:`escape`'s goal cell and cost (-1 and +inf without a candidate) for a
+        pursuer whose region is not at hand, computing the region only where the search
+        looks (:func:`escape_goal`; Euclidean distances only)."""
+        if self.distance != "euclidean":
+            raise ValueError("EscapeSearch.goal computes Euclidean distances only.")
+        component = self._component_at(me)
+        agents = (me.x, me.y, pursuer.x, pursuer.y, pursuer.theta)
+        cells, boxes, sight, rays, half_widths = self.kernel_inputs(component)
+        cell, cost = escape_goal(cells, boxes, sight, rays, half_widths, agents, self.scratch())
+        return int(cell), float(cost)
+
+    def kernel_inputs(
+        self, component: _Component
+    ) -> tuple[tuple, np.ndarray, tuple, tuple, np.ndarray]:
+        """:func:`escape_goal`'s arguments before ``agents`` for the evaders of
+        ``component``: (cells, boxes, sight, rays, half_widths)."""
+        grid = self.grid
+        cells = TiledCells(
+            component.starts, component.rows, component.cols, grid.kernel_frame, grid.width
+        )
+        return tuple(cells), component.boxes, *self.view_inputs()
+
+    def view_inputs(self) -> tuple[tuple, tuple, np.ndarray]:
+        """:func:`escape_goal`'s (sight, rays, half_widths): the grid, the pursuer's
+        camera and the hide margin as the kernel takes them."""
+        grid, camera = self.grid, self.camera
+        angles, distances, first = ray_tables(camera)
+        rays = Rays(
+            angles,
+            distances,
+            first,
+            camera.angle_step,
+            camera.distance_step,
+            camera.fov,
+            camera.far,
+        )
+        sight = Sight(grid.blocked, grid.kernel_frame, float(grid.origin[2]))
+        return tuple(sight), tuple(rays), self._half_widths
+
+    def scratch(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:func:`escape_goal`'s scratch memory for this search's grid and camera, made at
+        the first call (the kernel leaves it as it found it)."""
+        if self._scratch is None:
+            angles, distances, _ = ray_tables(self.camera)
+            self._scratch = (
+                np.zeros(self.grid.blocked.shape, dtype=np.bool_),
+                np.zeros(angles.size, dtype=np.int64),
+                np.empty(distances.size, dtype=np.int64),
+            )
+        return self._scratch
 
     def escape_reference(self, me: Pose, pursuer: Pose) -> Escape:
         """:meth:`escape` in plain numpy over every candidate: the tests' reference."""

@@ -19,7 +19,8 @@ from numba import njit
 from numpy.typing import ArrayLike
 
 from pegame.errors import require
-from pegame.types import STOP, Body, Pose, Velocity, clamp, wrap_angle
+from pegame.numerics import hypot, wrap_angle
+from pegame.types import STOP, Body, Pose, Velocity
 
 
 @njit(cache=True)
@@ -82,6 +83,50 @@ def _follow(
     target_x = path[i, 0] + t * (path[i + 1, 0] - path[i, 0])
     target_y = path[i, 1] + t * (path[i + 1, 1] - path[i, 1])
     return to_goal, progress, target_x, target_y
+
+
+@njit(cache=True)
+def follow_command(
+    path: tuple, progress: float, gains: tuple, limits: tuple, pose: tuple
+) -> tuple[float, float, float, bool]:
+    """:meth:`PathFollower.command`'s step for a path not yet done: (v (m/s), w (rad/s),
+    new progress (m), done).
+
+    path: (waypoints (K, 2), segment lengths (K-1,), arc lengths (K,)) as
+    :meth:`PathFollower.set_path` keeps them; progress: the progress point's arc length
+    (m); gains: (lookahead m, goal_tolerance m, rotate_threshold rad, turn_gain 1/s);
+    limits: (v_max m/s, w_max rad/s); pose: the agent's (x, y, theta) (m, m, rad). The
+    float operations are those of the Python controller it replaced (Python's hypot and
+    angle wrap through :mod:`pegame.numerics`), so the commands are the same bits;
+    batched strategies call it per game.
+    """
+    waypoints, seg_len, arc = path
+    lookahead, goal_tolerance, rotate_threshold, turn_gain = gains
+    v_max, w_max = limits
+    x, y, theta = pose
+    to_goal, progress, target_x, target_y = _follow(
+        waypoints, seg_len, arc, progress, lookahead, x, y
+    )
+    if to_goal <= goal_tolerance:
+        return 0.0, 0.0, progress, True
+    dx, dy = target_x - x, target_y - y
+    error = wrap_angle(math.atan2(dy, dx) - theta)
+    if abs(error) > rotate_threshold:
+        return 0.0, _clamp(turn_gain * error, w_max), progress, False
+    # Pure pursuit: the arc through the target tangent to the heading has curvature
+    # 2 sin(error) / distance.
+    curvature = 2.0 * math.sin(error) / max(hypot(dx, dy), 1e-9)
+    remaining = arc[arc.size - 1] - progress
+    v = v_max * min(1.0, max(remaining, to_goal) / lookahead)
+    if abs(curvature) * v > w_max:
+        v = w_max / abs(curvature)
+    return v, _clamp(curvature * v, w_max), progress, False
+
+
+@njit(cache=True, inline="always")
+def _clamp(value: float, limit: float) -> float:
+    """:func:`pegame.types.clamp` in numba code."""
+    return min(max(value, -limit), limit)
 
 
 def _follow_reference(
@@ -171,26 +216,15 @@ class PathFollower:
         Turns in place (v = 0) when the heading error to the lookahead point exceeds
         rotate_threshold; otherwise drives the pure-pursuit arc through that point at a
         speed reduced within one lookahead of the goal and so that the turn rate stays
-        within w_max.
+        within w_max (the kernel :func:`follow_command`).
         """
         if self._done:
             return STOP
-        to_goal, progress, target_x, target_y = _follow(
-            self.path, self._seg_len, self._arc, self._progress, self.lookahead, pose.x, pose.y
+        v, w, self._progress, self._done = follow_command(
+            (self.path, self._seg_len, self._arc),
+            self._progress,
+            (self.lookahead, self.goal_tolerance, self.rotate_threshold, self.turn_gain),
+            (self.body.v_max, self.body.w_max),
+            (pose.x, pose.y, pose.theta),
         )
-        if to_goal <= self.goal_tolerance:
-            self._done = True
-            return STOP
-        self._progress = progress
-        dx, dy = target_x - pose.x, target_y - pose.y
-        error = wrap_angle(math.atan2(dy, dx) - pose.theta)
-        v_max, w_max = self.body.v_max, self.body.w_max
-        if abs(error) > self.rotate_threshold:
-            return Velocity(0.0, clamp(self.turn_gain * error, w_max))
-        # Pure pursuit: the arc through the target tangent to the heading has curvature
-        # 2 sin(error) / distance.
-        curvature = 2.0 * math.sin(error) / max(math.hypot(dx, dy), 1e-9)
-        v = v_max * min(1.0, max(self.remaining, to_goal) / self.lookahead)
-        if abs(curvature) * v > w_max:
-            v = w_max / abs(curvature)
-        return Velocity(v, clamp(curvature * v, w_max))
+        return Velocity(v, w)

@@ -213,6 +213,12 @@ class Planner:
         cell = self._source_cell(xy)
         return None if cell is None else self.grid.cell_to_world(*cell)
 
+    @property
+    def labels(self) -> np.ndarray:
+        """Int (H, W): the connected components of the traversable cells under the
+        planner's moves, labelled 1, 2, ...; 0 for cells not traversable. Read-only."""
+        return self._labels
+
     def reachable(self, xy: XY) -> np.ndarray:
         """Bool (H, W): the traversable cells connected to xy's cell (or to the nearest
         traversable cell when xy's cell is not traversable)."""
@@ -311,6 +317,21 @@ class Planner:
         if d[best] > self.goal_snap + DISTANCE_TOLERANCE:
             return None
         return int(rows[best]), int(cols[best])
+
+    def search_tables(self) -> tuple[tuple, tuple, tuple, np.ndarray, np.ndarray]:
+        """What a kernel needs to plan as :meth:`plan` does between traversable cells:
+        (lattice, heuristic, scratch) as :func:`pegame.navigation.search.astar` takes
+        them, the bool (H, W) traversable cells and the int (2, H, W) nearest traversable
+        cell of every cell (as :meth:`plan` picks its start). The scratch is this
+        planner's own: one search at a time."""
+        heuristic = tuple(Heuristic(self._landmark_table(), self.tie_quantum))
+        return (
+            self._lattice,
+            heuristic,
+            self._search_scratch(),
+            self.traversable,
+            self._nearest_cells(),
+        )
 
     def plan(self, start_xy: XY, goal_xy: XY) -> PathResult:
         """Minimum weighted cost path from start_xy to goal_xy (map frame, m); never raises.

@@ -4,6 +4,10 @@
   (:class:`pegame.wander.RandomActions`), batched: at a game's reset every decision's
   (v, w) is drawn at once from the strategy's own generator, the same numbers the
   strategy would draw one decision at a time, and the tick kernel reads them;
+- :class:`SmartEvaderOpponent`: the smart evader (Euclidean distances, its default),
+  decided and commanded for every game of a tick in one kernel call
+  (:class:`pegame.evaders.smart_batch.SmartEvaderBatch`), the strategy's commands bit
+  for bit;
 - :class:`StrategyOpponent`: any other evader strategy (``smart``, ``random`` with
   ``model=waypoint``, any plugin): one instance per game, built exactly as
   :class:`pegame.game.Game` builds it and asked, game by game in Python, for its decision
@@ -33,6 +37,8 @@ from pegame.api import (
     PursuerObservation,
 )
 from pegame.evaders.random import RandomEvader
+from pegame.evaders.smart import SmartEvader
+from pegame.evaders.smart_batch import SmartEvaderBatch, batchable
 from pegame.game import Scenario
 from pegame.metrics import TrackingMetrics
 from pegame.pursuers.random import RandomPursuer
@@ -121,6 +127,30 @@ class StrategyOpponent:
             commands[game, EVADER, 0], commands[game, EVADER, 1] = cmd.v, cmd.w
 
 
+class SmartEvaderOpponent:
+    """The smart evader with ``config`` in ``context``, batched over ``num_games`` games."""
+
+    role = EVADER
+    table = None
+
+    def __init__(self, config: Any, context: Context, num_games: int) -> None:
+        self.batch = SmartEvaderBatch(config, context, num_games)
+
+    def reset(self, game: int, streams: dict, pose: Pose) -> None:
+        """Game ``game`` starts (the smart evader draws nothing from its stream)."""
+        self.batch.reset(game)
+
+    def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
+        """Nothing: the evader is told the poses when it is asked."""
+
+    def command(
+        self, state: BatchState, games: np.ndarray, time: np.ndarray, deciding: np.ndarray
+    ) -> None:
+        """The evaders' commands for ``games`` into state.commands, deciding first where
+        ``deciding[k]`` (the smart evader does not read the time)."""
+        self.batch.command(state.poses, state.commands, games, deciding)
+
+
 class PursuerStrategyOpponent:
     """The pursuer strategy ``cls`` with ``config``, and the estimator ``estimator`` (a
     (class, config) pair), in ``context``, one of each per game."""
@@ -201,7 +231,7 @@ class PursuerStrategyOpponent:
 
 def opponent_for(
     scenario: Scenario, learner: str, bodies: np.ndarray, num_games: int
-) -> ActionTable | StrategyOpponent | PursuerStrategyOpponent:
+) -> ActionTable | SmartEvaderOpponent | StrategyOpponent | PursuerStrategyOpponent:
     """The opponent of ``learner`` ('pursuer' or 'evader') in ``scenario``'s games."""
     role = "evader" if learner == "pursuer" else "pursuer"
     cls, config = scenario.classes[role], scenario.configs[role]
@@ -210,6 +240,8 @@ def opponent_for(
     index = EVADER if role == "evader" else PURSUER
     if cls in (RandomEvader, RandomPursuer) and config.model == "action":
         return ActionTable(index, bodies[index], num_games, decisions)
+    if cls is SmartEvader and batchable(config):
+        return SmartEvaderOpponent(config, scenario.context, num_games)
     if role == "evader":
         assert issubclass(cls, Evader)  # the scenario's classes implement their kinds
         return StrategyOpponent(cls, config, scenario.context, num_games)

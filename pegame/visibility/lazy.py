@@ -4,7 +4,7 @@
 for the camera at one pose. Most consumers need only part of it: the particle filter asks
 whether its particles' cells are in the region, and they usually lie in a small block of
 the grid. For a block of cells the kernels here march only the rays that can reach it
-(:func:`_rays_reaching`), only as far as the block, and skip cells that cannot meet the
+(:func:`rays_reaching`), only as far as the block, and skip cells that cannot meet the
 field of view's wedge (:func:`_near_wedge`). On the block this gives exactly the cells of
 the whole mask: the same rays are sampled at the same points (:mod:`pegame.visibility.rays`)
 and stop at the same blocked sample, and no other sample can land in the block.
@@ -146,7 +146,7 @@ def _mask_over(sight: tuple, eye: tuple, rays: tuple, block: Block) -> np.ndarra
     blocked, frame, yaw = sight
     px, py, theta = eye
     angles, distances, first, _, _, _, _ = rays
-    i0, i1, samples = _rays_reaching(rays, eye, frame, yaw, block)
+    i0, i1, samples = rays_reaching(rays, eye, frame, yaw, block)
     mask = np.zeros(blocked.shape, dtype=np.bool_)
     if i1 > i0 and samples > first:
         cos_a, sin_a = directions(theta, angles, i0, i1)
@@ -219,12 +219,12 @@ def _near_wedge(
     return near, (r0, r1, c0, c1)
 
 
-#: cells; how far :func:`_rays_reaching` grows a block to absorb rounding at cell edges
+#: cells; how far :func:`rays_reaching` grows a block to absorb rounding at cell edges
 _REACH_MARGIN = 0.5
 
 
 @njit(cache=True)
-def _rays_reaching(
+def rays_reaching(
     rays: tuple, eye: tuple, frame: tuple, yaw: float, block: Block
 ) -> tuple[int, int, int]:
     """(first ray, stop ray, samples): the ``rays`` angles[first:stop] (rad from the

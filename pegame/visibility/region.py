@@ -136,27 +136,52 @@ def march(
     computation at the first blocked sample. A ray's cells move monotonically in row and
     column, so its first and last marked cells bound all of its marked cells.
     """
-    blocked_flat, mask_flat = blocked.ravel(), mask.ravel()
     width = blocked.shape[1]
-    r0, r1, c0, c1 = blocked.shape[0], 0, width, 0
+    bounds = (blocked.shape[0], 0, width, 0)
     cells = np.empty(distances.size, dtype=np.int64)
     for i in range(cos_a.size):
         ray = (cos_a[i], sin_a[i])
-        if not _ray_cells(px, py, ray, distances, frame, blocked.shape, False, cells):
-            _ray_cells(px, py, ray, distances, frame, blocked.shape, True, cells)
-        stop = distances.size
-        for j in range(distances.size):
-            cell = cells[j]
-            if cell < 0 or blocked_flat[cell]:
-                stop = j
-                break
-            if j >= first:
-                mask_flat[cell] = True
-        if stop > first:
-            for end in (cells[first], cells[stop - 1]):
-                row, col = end // width, end % width
-                r0, r1, c0, c1 = min(r0, row), max(r1, row + 1), min(c0, col), max(c1, col + 1)
-    return r0, r1, c0, c1
+        bounds = march_ray(blocked, ray, distances, first, px, py, frame, cells, mask, bounds)[1]
+    return bounds
+
+
+@njit(cache=True, inline="always")
+def march_ray(
+    blocked: np.ndarray,
+    ray: tuple[float, float],
+    distances: np.ndarray,
+    first: int,
+    px: float,
+    py: float,
+    frame: tuple,
+    cells: np.ndarray,
+    mask: np.ndarray,
+    bounds: tuple[int, int, int, int],
+) -> tuple[int, tuple[int, int, int, int]]:
+    """One ray of :func:`march`: mark in ``mask`` the cells of its samples ``distances``
+    (ranges in m, from index ``first`` on) before the first blocked or off-grid one;
+    return that sample's index (distances.size when none) and ``bounds`` (r0, r1, c0,
+    c1) grown to hold the marks. ``cells``: scratch of at least distances.size entries.
+    A sample's cell depends on its range alone, so a ray may be marched in pieces of
+    consecutive ranges, and it marks the same cells whichever other rays are marched."""
+    blocked_flat, mask_flat = blocked.ravel(), mask.ravel()
+    width = blocked.shape[1]
+    if not _ray_cells(px, py, ray, distances, frame, blocked.shape, False, cells):
+        _ray_cells(px, py, ray, distances, frame, blocked.shape, True, cells)
+    stop = distances.size
+    for j in range(distances.size):
+        cell = cells[j]
+        if cell < 0 or blocked_flat[cell]:
+            stop = j
+            break
+        if j >= first:
+            mask_flat[cell] = True
+    r0, r1, c0, c1 = bounds
+    if stop > first:
+        for end in (cells[first], cells[stop - 1]):
+            row, col = end // width, end % width
+            r0, r1, c0, c1 = min(r0, row), max(r1, row + 1), min(c0, col), max(c1, col + 1)
+    return stop, (r0, r1, c0, c1)
 
 
 def visibility_region(grid: OccupancyGrid, pose: Pose, camera: Camera) -> np.ndarray:

@@ -208,10 +208,13 @@ def test_goal_is_the_brute_force_argmin(distance, seed, margin):
 
 
 def assert_same_escape(smart, me, pursuer):
-    """The fast escape equals the numpy reference exactly; returns it."""
+    """The fast escape equals the numpy reference exactly, and so does the goal found
+    with the region computed only where the search looks (Euclidean); returns it."""
     fast, slow = smart.search.escape(me, pursuer), smart.search.escape_reference(me, pursuer)
     assert (fast.cell, fast.cost, fast.count) == (slow.cell, slow.cost, slow.count)
     np.testing.assert_array_equal(fast.sample, slow.sample)
+    if smart.config.distance == "euclidean":
+        assert smart.search.goal(me, pursuer) == (slow.cell, slow.cost)
     return fast
 
 
@@ -457,3 +460,25 @@ def test_candidate_stride_scores_every_kth_cell():
 def test_bad_config_names_the_key(params, key):
     with pytest.raises(ConfigError, match=key.replace(".", r"\.")):
         make_config("evader", SmartEvader, params)
+
+
+@pytest.mark.parametrize("margin", [0.12, 0.3])
+def test_the_goal_found_in_part_of_the_region_is_the_references_with_the_evader_in_view(margin):
+    """The pursuer close by and facing the evader, as in most decisions of a tracked
+    evader: the search scores many tiles in and about the region, which it marches ray
+    piece by ray piece; the goal and cost stay the reference's."""
+    grid = load_map(MAPS_DIR / "enclosed.yaml")
+    camera, evader, pursuer_body = Camera(), Body(0.25, 0.5, 1.8), Body(0.2, 0.5, 1.8)
+    smart = make_evader(
+        grid, camera=camera, evader=evader, pursuer=pursuer_body, hide_margin=margin
+    )
+    rows, cols = np.nonzero(smart.planner.traversable)
+    rng = np.random.default_rng(5)
+    for _ in range(40):
+        i = rng.integers(rows.size)
+        me = Pose(*grid.cell_to_world(rows[i], cols[i]), 0.0)
+        distance, bearing = rng.uniform(0.3, 2.5), rng.uniform(-math.pi, math.pi)
+        x, y = me.x - distance * math.cos(bearing), me.y - distance * math.sin(bearing)
+        pursuer = Pose(x, y, bearing + rng.uniform(-0.4, 0.4))
+        slow = smart.search.escape_reference(me, pursuer)
+        assert smart.search.goal(me, pursuer) == (slow.cell, slow.cost)
