@@ -124,6 +124,14 @@ def append_line(path: Path, entry: dict[str, Any]) -> None:
         raise ResultsWriteError(f"{exc} The unwritten line is printed above on stderr.") from None
 
 
+def say(line: str) -> None:
+    """Print ``line`` on stdout in one write with its newline: under PYTHONUNBUFFERED,
+    print writes a line and its end apart, and a sweep's processes share the stream, so
+    another's line could be written between them and join this one."""
+    sys.stdout.write(line + "\n")
+    sys.stdout.flush()
+
+
 def progress(seeds: list[int]) -> Iterator[int]:
     """Iterate ``seeds`` with a progress bar when stderr is a terminal."""
     if not sys.stderr.isatty() or len(seeds) < 2:
@@ -202,12 +210,12 @@ def _run_locked(
         run.played.append(outcome.result)
         if single:
             write_single(outcome, game, out_dir)
-        print(f"{cell}: {summary_line(outcome.result)}" if cell else summary_line(outcome.result))
+        say(f"{cell}: {summary_line(outcome.result)}" if cell else summary_line(outcome.result))
     if prepared is not None:
         prepared.plugins.sim.close()
     rates = [r["tracking_rate"] for r in run.played]
     if settings.trials > 1 and rates:
-        print(f"{cell}: {mean_line(rates)}" if cell else mean_line(rates))
+        say(f"{cell}: {mean_line(rates)}" if cell else mean_line(rates))
     append_line(
         results_path,
         {

@@ -350,3 +350,21 @@ def test_ctrl_c_stops_the_sweep_and_its_workers(tmp_path, sigint_ignored):
 
     workers = interrupt_mid_sweep(tmp_path, ctrl_c, sigint_ignored)
     assert_workers_stop(tmp_path, workers)
+
+
+def test_a_console_line_is_written_in_one_write_with_its_newline(monkeypatch):
+    """A sweep's processes share stdout, unbuffered in CI (PYTHONUNBUFFERED): print's two
+    writes (the text, then its end) let another process's line land between them, which
+    joined a progress line and a log line into one."""
+    writes = []
+
+    class Recorder:
+        def write(self, text):
+            writes.append(text)
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr(sys, "stdout", Recorder())
+    job.say("#0 evader=smart: seed 1 tracking 52.0%")
+    assert writes == ["#0 evader=smart: seed 1 tracking 52.0%\n"]

@@ -37,6 +37,7 @@ from omegaconf import DictConfig, open_dict
 from hydra_plugins.pegame_launcher._dead import cause, entries, record_dead_job
 from hydra_plugins.pegame_launcher._worker import serve
 from pegame import sweep
+from pegame.job import say
 
 log = logging.getLogger(__name__)
 
@@ -211,11 +212,10 @@ class Progress:
             return
         status = returned.return_value if returned.status == JobStatus.COMPLETED else "error"
         elapsed = time.perf_counter() - self.started
-        print(
+        say(
             f"pegame: cell {self.cells} of {len(self.games)} done (#{num} "
             f"{' '.join(filter_overrides(overrides))}): exit {status}, {elapsed:.0f} s; "
-            f"games {sum(self.counted)} of {self.total}",
-            flush=True,
+            f"games {sum(self.counted)} of {self.total}"
         )
 
     def close(self) -> None:
