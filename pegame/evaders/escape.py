@@ -323,6 +323,7 @@ def escape_goal(
     blocked, frame, yaw = sight
     angles, distances, first = rays[0], rays[1], rays[2]
     mask, marched, ray_cells = scratch
+    shape, flat = blocked.shape, (blocked.ravel(), mask.ravel())
     ex, ey, px, py, heading = agents
     eye = (px, py, heading)
     costs = ((ex, ey, px, py), np.zeros(0), np.zeros(0))
@@ -362,7 +363,8 @@ def escape_goal(
                     ray = (cos_a[i], sin_a[i])
                     ahead = distances[done:samples]
                     stop, marked = march_ray(
-                        blocked,
+                        flat,
+                        shape,
                         ray,
                         ahead,
                         max(first - done, 0),
@@ -370,7 +372,6 @@ def escape_goal(
                         py,
                         frame,
                         ray_cells,
-                        mask,
                         marked,
                     )
                     marched[i] = samples if stop == ahead.size else -1 - (done + stop)
