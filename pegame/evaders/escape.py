@@ -65,6 +65,8 @@ DISTANCES = ("euclidean", "geodesic")
 MAX_RECORDED_CANDIDATES = 250
 #: edge (cells) of the square tiles that the fast argmin search scores or skips as a whole
 TILE = 8
+#: edge (tiles) of the square groups of tiles whose bounds the lazy search starts from
+GROUP = 4
 #: tiles sorted by bound before the search starts (see EscapeSearch.escape); more than
 #: the paper maps have (at most 1900), so theirs are all sorted at once as before
 FIRST_TILES = 4096
@@ -180,12 +182,19 @@ def _tile_bounds(boxes: np.ndarray, ex: float, ey: float, px: float, py: float) 
     its farthest distance to the pursuer at (px, py)."""
     bounds = np.empty(boxes.shape[0])
     for t in range(boxes.shape[0]):
-        x0, x1, y0, y1 = boxes[t, 0], boxes[t, 1], boxes[t, 2], boxes[t, 3]
-        nx, ny = max(x0 - ex, ex - x1, 0.0), max(y0 - ey, ey - y1, 0.0)
-        fx, fy = max(abs(x0 - px), abs(x1 - px)), max(abs(y0 - py), abs(y1 - py))
-        far = math.sqrt(fx * fx + fy * fy)
-        bounds[t] = math.sqrt(nx * nx + ny * ny) / far if far > 0.0 else np.inf
+        bounds[t] = _box_bound(boxes, t, ex, ey, px, py)
     return bounds
+
+
+@njit(cache=True, inline="always")
+def _box_bound(boxes: np.ndarray, t: int, ex: float, ey: float, px: float, py: float) -> float:
+    """:func:`_tile_bounds` of box ``t``. A box holding another has a bound no larger
+    (its nearest distance no larger, its farthest no smaller, in floats too)."""
+    x0, x1, y0, y1 = boxes[t, 0], boxes[t, 1], boxes[t, 2], boxes[t, 3]
+    nx, ny = max(x0 - ex, ex - x1, 0.0), max(y0 - ey, ey - y1, 0.0)
+    fx, fy = max(abs(x0 - px), abs(x1 - px)), max(abs(y0 - py), abs(y1 - py))
+    far = math.sqrt(fx * fx + fy * fy)
+    return math.sqrt(nx * nx + ny * ny) / far if far > 0.0 else np.inf
 
 
 @njit(cache=True, inline="always")
@@ -290,7 +299,7 @@ def _score_tile(
 @njit(cache=True)
 def escape_goal(
     cells: tuple,
-    boxes: np.ndarray,
+    tiles: tuple,
     sight: tuple,
     rays: tuple,
     half_widths: np.ndarray,
@@ -299,13 +308,17 @@ def escape_goal(
 ) -> tuple[int, float]:
     """Algorithm 2's argmin (flat cell, cost; (-1, inf) without a candidate) for the
     evader and the pursuer at ``agents`` (ex, ey, px, py, pursuer heading) (m, rad), over
-    a component's tiled ``cells`` (:class:`TiledCells`) with tile ``boxes`` (T, 4),
+    a component's tiled ``cells`` (:class:`TiledCells`) with its ``tiles``: (boxes (T, 4),
+    groups) as :meth:`EscapeSearch.kernel_inputs` gives them,
     computing the pursuer's visibility region only where the search looks: the goal and
     cost of :meth:`EscapeSearch.escape` without its count and sample of the candidates.
 
     Tiles are scored in increasing bound from a heap, as far as :func:`_best_candidate`
     scores them (its argmin does not depend on the order of equal bounds: every tile whose
-    bound is within the slack of the final cost is scored). For a tile, V grown by the
+    bound is within the slack of the final cost is scored). The heap starts with groups
+    of GROUP x GROUP tiles (:func:`_group_tiles`) under their box's bound, no larger than
+    their tiles' bounds; a group popped puts its tiles in, so the bounds of most tiles
+    are never computed. For a tile, V grown by the
     hide margin (``half_widths``, :func:`disc_half_widths`) is only needed on its cells,
     so V is needed on the tile's block grown by the margin: the rays that can reach that
     block as far as they can reach it (:func:`pegame.visibility.lazy.rays_reaching`),
@@ -320,6 +333,7 @@ def escape_goal(
     pieces, each sample once: its scratch entry holds the samples marched, or -1 - the
     index of the blocked sample that stopped it.
     """
+    boxes, groups = tiles
     blocked, frame, yaw = sight
     angles, distances, first = rays[0], rays[1], rays[2]
     mask, marched, ray_cells = scratch
@@ -327,9 +341,14 @@ def escape_goal(
     ex, ey, px, py, heading = agents
     eye = (px, py, heading)
     costs = ((ex, ey, px, py), np.zeros(0), np.zeros(0))
-    bounds = _tile_bounds(boxes, ex, ey, px, py)
-    heap = _tile_heap(bounds)
-    size = heap.size
+    group_boxes, group_starts, members = groups
+    keys, items = (
+        np.empty(group_boxes.shape[0] + boxes.shape[0]),
+        np.empty(group_boxes.shape[0] + boxes.shape[0], dtype=np.int64),
+    )
+    size = 0
+    for g in range(group_boxes.shape[0]):  # a group g is the item -1 - g, a tile t is t
+        size = _push(keys, items, size, _box_bound(group_boxes, g, ex, ey, px, py), -1 - g)
     reach = half_widths.size - 1
     height, width = blocked.shape
     window = np.zeros((TILE, TILE), dtype=np.bool_)
@@ -340,10 +359,15 @@ def escape_goal(
     best_cell, best_cost = -1, np.inf
     starts, rows, cols = cells[0], cells[1], cells[2]
     while size > 0:
-        t = heap[0]
-        if bounds[t] > best_cost * (1.0 + BOUND_SLACK):
+        if keys[0] > best_cost * (1.0 + BOUND_SLACK):
             break
-        size = _heap_pop(heap, size, bounds)
+        t = items[0]
+        size = _pop(keys, items, size)
+        if t < 0:  # a group: its tiles join the heap
+            for m in range(group_starts[-1 - t], group_starts[-t]):
+                bound = _box_bound(boxes, members[m], ex, ey, px, py)
+                size = _push(keys, items, size, bound, members[m])
+            continue
         top = rows[starts[t]] // TILE * TILE
         left = cols[starts[t]] // TILE * TILE
         block = (
@@ -430,38 +454,39 @@ def _grown_tile(
             window[r, c] = near
 
 
-@njit(cache=True)
-def _tile_heap(bounds: np.ndarray) -> np.ndarray:
-    """The tiles 0..T-1 as a binary min-heap on ``bounds`` (T,)."""
-    heap = np.arange(bounds.size)
-    for start in range(bounds.size // 2 - 1, -1, -1):
-        _sift_down(heap, start, bounds.size, bounds)
-    return heap
+@njit(cache=True, inline="always")
+def _push(keys: np.ndarray, items: np.ndarray, size: int, key: float, item: int) -> int:
+    """Add ``item`` with ``key`` to the binary min-heap keys[:size], items[:size]; the new
+    size."""
+    slot = size
+    while slot > 0:
+        parent = (slot - 1) >> 1
+        if keys[parent] <= key:
+            break
+        keys[slot], items[slot] = keys[parent], items[parent]
+        slot = parent
+    keys[slot], items[slot] = key, item
+    return size + 1
 
 
 @njit(cache=True, inline="always")
-def _heap_pop(heap: np.ndarray, size: int, bounds: np.ndarray) -> int:
-    """Remove the root of the min-heap ``heap[:size]`` on ``bounds``; the new size."""
+def _pop(keys: np.ndarray, items: np.ndarray, size: int) -> int:
+    """Remove the root of the binary min-heap keys[:size], items[:size]; the new size."""
     size -= 1
-    heap[0] = heap[size]
-    _sift_down(heap, 0, size, bounds)
-    return size
-
-
-@njit(cache=True, inline="always")
-def _sift_down(heap: np.ndarray, slot: int, size: int, bounds: np.ndarray) -> None:
-    item = heap[slot]
+    key, item = keys[size], items[size]
+    slot = 0
     while True:
         child = 2 * slot + 1
         if child >= size:
             break
-        if child + 1 < size and bounds[heap[child + 1]] < bounds[heap[child]]:
+        if child + 1 < size and keys[child + 1] < keys[child]:
             child += 1
-        if bounds[heap[child]] >= bounds[item]:
+        if keys[child] >= key:
             break
-        heap[slot] = heap[child]
+        keys[slot], items[slot] = keys[child], items[child]
         slot = child
-    heap[slot] = item
+    keys[slot], items[slot] = key, item
+    return size
 
 
 @njit(cache=True)
@@ -540,7 +565,8 @@ def _group_by_tile(
 class _Component:
     """The candidate cells (on the candidate stride) of one connected component.
 
-    mask: bool (H, W), the component. The rest as :func:`_group_by_tile` returns them:
+    mask: bool (H, W), the component. groups: its tiles grouped, as :func:`_group_tiles`
+    returns them. The rest as :func:`_group_by_tile` returns them:
     cells, flat indices (K,), row-major; position, (H * W,) index of each flat cell in
     ``cells``, -1 elsewhere; rows and cols (K,), the cells grouped by tile; starts, (T +
     1,) where each tile's cells begin in rows and cols; boxes, (T, 4) (x min, x max, y
@@ -554,12 +580,40 @@ class _Component:
     cols: np.ndarray
     starts: np.ndarray
     boxes: np.ndarray
+    groups: tuple[np.ndarray, np.ndarray, np.ndarray]
 
     @classmethod
     def build(cls, mask: np.ndarray, strided: np.ndarray, frame: tuple) -> _Component:
         """The component ``mask`` (bool (H, W)) with its cells on the ``strided`` mask
         (bool (H, W)) of a grid with map-to-cell transform ``frame``."""
-        return cls(mask, *_group_by_tile(mask & strided, frame))
+        cells, position, rows, cols, starts, boxes = _group_by_tile(mask & strided, frame)
+        groups = _group_tiles(rows, cols, starts, boxes)
+        return cls(mask, cells, position, rows, cols, starts, boxes, groups)
+
+
+def _group_tiles(
+    rows: np.ndarray, cols: np.ndarray, starts: np.ndarray, boxes: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The tiles (as :func:`_group_by_tile` returns them) in groups of GROUP x GROUP tiles:
+    (group boxes (G, 4), the smallest holding their tiles' boxes; where each group's
+    tiles begin in ``members``, (G + 1,); members (T,), the tiles, group by group)."""
+    first = starts[:-1]
+    span = TILE * GROUP
+    key = (rows[first].astype(np.int64) // span) * (cols.max(initial=0) // span + 1) + (
+        cols[first].astype(np.int64) // span
+    )
+    members = np.argsort(key, kind="stable")
+    ordered = key[members]
+    begins = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]]) if members.size else members
+    group_starts = np.append(begins, members.size).astype(np.int64)
+    sorted_boxes = boxes[members]
+    group_boxes = np.empty((begins.size, 4))
+    if begins.size:
+        group_boxes[:, 0] = np.minimum.reduceat(sorted_boxes[:, 0], begins)
+        group_boxes[:, 1] = np.maximum.reduceat(sorted_boxes[:, 1], begins)
+        group_boxes[:, 2] = np.minimum.reduceat(sorted_boxes[:, 2], begins)
+        group_boxes[:, 3] = np.maximum.reduceat(sorted_boxes[:, 3], begins)
+    return group_boxes, group_starts, members.astype(np.int64)
 
 
 class EscapeSearch:
@@ -640,20 +694,18 @@ class EscapeSearch:
             raise ValueError("EscapeSearch.goal computes Euclidean distances only.")
         component = self._component_at(me)
         agents = (me.x, me.y, pursuer.x, pursuer.y, pursuer.theta)
-        cells, boxes, sight, rays, half_widths = self.kernel_inputs(component)
-        cell, cost = escape_goal(cells, boxes, sight, rays, half_widths, agents, self.scratch())
+        cells, tiles, sight, rays, half_widths = self.kernel_inputs(component)
+        cell, cost = escape_goal(cells, tiles, sight, rays, half_widths, agents, self.scratch())
         return int(cell), float(cost)
 
-    def kernel_inputs(
-        self, component: _Component
-    ) -> tuple[tuple, np.ndarray, tuple, tuple, np.ndarray]:
+    def kernel_inputs(self, component: _Component) -> tuple[tuple, tuple, tuple, tuple, np.ndarray]:
         """:func:`escape_goal`'s arguments before ``agents`` for the evaders of
-        ``component``: (cells, boxes, sight, rays, half_widths)."""
+        ``component``: (cells, tiles, sight, rays, half_widths)."""
         grid = self.grid
         cells = TiledCells(
             component.starts, component.rows, component.cols, grid.kernel_frame, grid.width
         )
-        return tuple(cells), component.boxes, *self.view_inputs()
+        return tuple(cells), (component.boxes, component.groups), *self.view_inputs()
 
     def view_inputs(self) -> tuple[tuple, tuple, np.ndarray]:
         """:func:`escape_goal`'s (sight, rays, half_widths): the grid, the pursuer's

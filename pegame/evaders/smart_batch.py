@@ -70,7 +70,7 @@ class SmartEvaderBatch:
         self.arc = np.zeros((num_games, FIRST_CAPACITY))
         self.component = np.zeros(num_games, dtype=np.int64)
         self._labels: dict[int, int] = {}  # planner label -> component index
-        self._components: list[tuple] = []  # their (cells, boxes) kernel inputs
+        self._components: list[tuple] = []  # their (cells, tiles) kernel inputs
         self._pool: tuple = ()
         search, planner, follower = (
             self.strategy.search,
@@ -161,19 +161,24 @@ class SmartEvaderBatch:
 
     def _add(self, label: int, component: Any) -> None:
         """Add ``component`` (of planner label ``label``) to the pool: its tile starts,
-        cell rows and columns and tile boxes after the earlier components', with the
-        offsets of every component's cells and tiles."""
+        cell rows and columns, tile boxes, group boxes, group starts and group members
+        after the earlier components', with the offsets of every component's cells, tiles
+        and groups (starts hold one entry more per component)."""
         self._labels[label] = len(self._components)
-        cells, boxes = self.strategy.search.kernel_inputs(component)[:2]
-        self._components.append((cells, boxes))
+        cells, tiles = self.strategy.search.kernel_inputs(component)[:2]
+        self._components.append((cells, tiles))
         parts = self._components
         self._pool = (
             np.concatenate([c[0] for c, _ in parts]),
             np.concatenate([c[1] for c, _ in parts]),
             np.concatenate([c[2] for c, _ in parts]),
-            np.concatenate([b for _, b in parts]),
+            np.concatenate([t[0] for _, t in parts]),
+            np.concatenate([t[1][0] for _, t in parts]),
+            np.concatenate([t[1][1] for _, t in parts]),
+            np.concatenate([t[1][2] for _, t in parts]),
             np.cumsum([0] + [c[1].size for c, _ in parts]),
-            np.cumsum([0] + [b.shape[0] for _, b in parts]),
+            np.cumsum([0] + [t[0].shape[0] for _, t in parts]),
+            np.cumsum([0] + [t[1][0].shape[0] for _, t in parts]),
         )
 
 
@@ -194,7 +199,8 @@ def _play(
     """:meth:`SmartEvaderBatch.command`'s kernel: -1 when every game is commanded, else
     the position in ``games`` of the first game whose new path did not fit (its state
     and command untouched, those after it too)."""
-    starts, rows, cols, boxes, cell_offsets, tile_offsets = pool
+    starts, rows, cols, boxes, group_boxes, group_starts, members = pool[:7]
+    cell_offsets, tile_offsets, group_offsets = pool[7:]
     sight, rays, half_widths, frame, width, scratch = search
     lattice, heuristic, astar_scratch, traversable, nearest = planner
     gains, limits = follower
@@ -210,10 +216,13 @@ def _play(
             c = component[game]
             t0, t1 = tile_offsets[c], tile_offsets[c + 1]
             k0, k1 = cell_offsets[c], cell_offsets[c + 1]
-            # A component's tile starts are its own (T + 1,), after c earlier ones' ends.
+            g0, g1 = group_offsets[c], group_offsets[c + 1]
+            # A component's starts are its own (T + 1,), after c earlier ones' ends.
             cells = (starts[t0 + c : t1 + c + 1], rows[k0:k1], cols[k0:k1], frame, width)
+            groups = (group_boxes[g0:g1], group_starts[g0 + c : g1 + c + 1], members[t0:t1])
             agents = (ex, ey, px, py, heading)
-            cell, _ = escape_goal(cells, boxes[t0:t1], sight, rays, half_widths, agents, scratch)
+            tiles = (boxes[t0:t1], groups)
+            cell, _ = escape_goal(cells, tiles, sight, rays, half_widths, agents, scratch)
             if cell >= 0 and _needs_path(cell, goal_cell[game], path_length[game], width):
                 row, col = point_cell(ex, ey, frame)
                 row, col = min(max(row, 0), height - 1), min(max(col, 0), width - 1)
