@@ -126,7 +126,7 @@ class _DecisionPeriods:
 def bench_vector_env(
     seconds: float = 20.0,
     num_envs: int = 4096,
-    smart_envs: int = 256,
+    smart_envs: int = 1024,
     overrides: Sequence[str] = ("env=enclosed",),
     seed: int = 0,
     single_steps: int = 300,
