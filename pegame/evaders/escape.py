@@ -49,8 +49,7 @@ from numpy.typing import ArrayLike
 from scipy.ndimage import distance_transform_edt
 
 from pegame.grid import OccupancyGrid, per_grid
-from pegame.grid.cells import cell_centres
-from pegame.grid.occupancy import COS_YAW, OX, OY, RESOLUTION, ROTATED, SIN_YAW
+from pegame.grid.cells import cell_centre, cell_centres
 from pegame.navigation import Planner
 from pegame.types import Camera, Pose, Region
 from pegame.visibility import VisibilityRegion, visibility_region
@@ -197,18 +196,6 @@ def _box_bound(boxes: np.ndarray, t: int, ex: float, ey: float, px: float, py: f
     return math.sqrt(nx * nx + ny * ny) / far if far > 0.0 else np.inf
 
 
-@njit(cache=True, inline="always")
-def _cell_centre(row: int, col: int, frame: tuple) -> tuple[float, float]:
-    """Map-frame centre (x, y) (m) of cell (row, col), by the operations of
-    :meth:`pegame.grid.OccupancyGrid.cell_to_world` (so the same floats)."""
-    u = (float(col) + 0.5) * frame[RESOLUTION]
-    v = (float(row) + 0.5) * frame[RESOLUTION]
-    if frame[ROTATED]:
-        c, s = frame[COS_YAW], frame[SIN_YAW]
-        u, v = c * u - s * v, s * u + c * v
-    return u + frame[OX], v + frame[OY]
-
-
 class TiledCells(NamedTuple):
     """A component's candidate cells grouped by tile (:func:`_group_by_tile`), on their grid."""
 
@@ -287,7 +274,7 @@ def _score_tile(
         if effort.size:
             e, d = effort[cell], dist[cell]
         else:
-            x, y = _cell_centre(rows[k], cols[k], frame)
+            x, y = cell_centre(rows[k], cols[k], frame)
             ax, ay, bx, by = x - ex, y - ey, x - px, y - py
             e, d = math.sqrt(ax * ax + ay * ay), math.sqrt(bx * bx + by * by)
         cost = e / d if d > 0.0 else np.inf
@@ -550,7 +537,7 @@ def _group_by_tile(
                     if candidate[row, col]:
                         rows[k], cols[k] = row, col
                         k += 1
-                        x, y = _cell_centre(row, col, frame)
+                        x, y = cell_centre(row, col, frame)
                         x0, x1, y0, y1 = min(x0, x), max(x1, x), min(y0, y), max(y1, y)
             if k > first:
                 starts[tiles] = first

@@ -11,8 +11,9 @@ At every decision the evader is told the pursuer's pose (the paper's assumption)
    ``cost_escape[i] = cost_effort[i] / cost_dist[i]``, where cost_effort is the distance
    (m) from the evader to the candidate and cost_dist the distance (m) from the pursuer to
    it; a candidate at distance 0 from the pursuer costs +inf (no division by zero);
-4. navigates to the argmin: :meth:`Planner.plan` for the path, :class:`PathFollower`
-   for the (v, w) commands at control ticks.
+4. navigates to the argmin: a path as :meth:`Planner.plan` finds it, and
+   :class:`PathFollower`'s pure pursuit for the (v, w) commands at control ticks (both
+   by :class:`pegame.navigation.goals.GoalPaths`, which the batched smart evader shares).
 
 Distances (``Config.distance``): ``euclidean`` is the paper's straight-line distance
 between the agents' positions and the candidate cell centres; ``geodesic`` is the
@@ -81,7 +82,8 @@ from pegame.evaders.escape import (
     subsample,
 )
 from pegame.navigation import PathFollower, Planner
-from pegame.types import STOP, Plan, Pose, Region, Velocity
+from pegame.navigation.goals import GoalPaths
+from pegame.types import Plan, Pose, Region, Velocity
 from pegame.visibility import UnionRegion, VisibilityRegion
 
 log = logging.getLogger(__name__)
@@ -128,13 +130,13 @@ class SmartEvader(Evader):
             config.candidate_stride,
             config.hide_margin,
         )
-        self.follower = PathFollower(context.evader)
+        #: the goal followed and its path: a batch of one (pegame.navigation.goals)
+        self.paths = GoalPaths(grid, self.planner, PathFollower(context.evader), 1)
         self.plan = Plan()
-        self._goal_cell: tuple[int, int] | None = None
 
     def reset(self, pose: Pose) -> None:
-        self.plan, self._goal_cell = Plan(), None
-        self.follower.set_path(np.zeros((0, 2)))
+        self.plan = Plan()
+        self.paths.reset(0)
 
     def decide(self, observation: EvaderObservation) -> Plan:
         """Find the escape goal for this tick's V; replan when it moved by more than a cell.
@@ -161,14 +163,10 @@ class SmartEvader(Evader):
                 {"candidates": np.zeros((0, 2)), "escape_cost": math.inf},
             )
             return self.plan
-        cell = divmod(found.cell, self.context.grid.width)
         goal, path = self.plan.goal, self.plan.path
-        if self._needs_replan(cell):
+        if self.paths.steer(0, found.cell, me.x, me.y):
             x, y = self.search.centres(found.cell)
-            goal = (float(x), float(y))
-            path = self.planner.plan((me.x, me.y), goal).path
-            self.follower.set_path(path)
-            self._goal_cell = cell
+            goal, path = (float(x), float(y)), self.paths.path(0)
         info = {
             "candidates": self.search.centres(found.sample),
             "escape_cost": found.cost,
@@ -232,11 +230,5 @@ class SmartEvader(Evader):
         return grown
 
     def control(self, observation: EvaderObservation) -> Velocity:
-        return self.follower.command(observation.pose) if self.plan.goal is not None else STOP
-
-    def _needs_replan(self, cell: tuple[int, int]) -> bool:
-        """True when there is no path to follow or ``cell`` is more than one cell (Chebyshev)
-        from the goal being followed."""
-        if self._goal_cell is None or len(self.follower.path) == 0:
-            return True
-        return max(abs(cell[0] - self._goal_cell[0]), abs(cell[1] - self._goal_cell[1])) > 1
+        pose = observation.pose
+        return Velocity(*self.paths.command(0, pose.x, pose.y, pose.theta))

@@ -7,13 +7,8 @@ the same kernels, so each game's commands are the strategy's, bit for bit:
 - at a decision tick, the escape goal by :func:`pegame.evaders.escape.escape_goal` (the
   pursuer's region computed only where the argmin search looks; the strategy's search
   computes the whole region, with the same goal and cost);
-- a new path when the goal moved by more than one cell (Chebyshev) from the goal being
-  followed, or there is no path: A* (:func:`pegame.navigation.search.astar`, the
-  planner's tables) from the cell :meth:`pegame.navigation.Planner.plan` starts from to
-  the goal cell, the cells' centres then the goal point (a candidate cell is traversable
-  and in the evader's component, so the goal is never snapped and always reached);
-- at every tick the pure-pursuit command (:func:`pegame.navigation.follower.follow_command`),
-  or a stop before the first goal.
+- the goal followed, its path and the command at every tick by the kernels of
+  :mod:`pegame.navigation.goals`, which the strategy calls for its batch of one.
 
 Not kept: the plan's info (the recorded candidates and the escape cost) and the INFO log
 when no candidate exists, which a recorder and a log read; a batched game has neither.
@@ -30,15 +25,11 @@ import numpy as np
 from numba import njit
 
 from pegame.api import Context
-from pegame.evaders.escape import _cell_centre, escape_goal
+from pegame.evaders.escape import escape_goal
 from pegame.evaders.smart import SmartEvader
-from pegame.grid.cells import point_cell
-from pegame.navigation.follower import follow_command
-from pegame.navigation.search import astar
+from pegame.navigation import PathFollower
+from pegame.navigation.goals import GoalPaths, command, steer
 from pegame.types import Pose
-
-#: waypoints a game's path holds at first; a longer path grows every game's room
-FIRST_CAPACITY = 256
 
 
 def batchable(config: Any) -> bool:
@@ -47,70 +38,28 @@ def batchable(config: Any) -> bool:
 
 
 class SmartEvaderBatch:
-    """The smart evader with ``config`` in ``context``, in ``num_games`` games.
-
-    Per game (first axis): the goal cell being followed (flat row-major, -1 before the
-    first), whether a goal was set, the path (waypoints, segment lengths, arc lengths,
-    count) and the follower's progress (m) and done flag. The candidate cells of each
-    connected component the evaders stand in are kept in one pool, a component's tiles
-    found by their offsets.
-    """
+    """The smart evader with ``config`` in ``context``, in ``num_games`` games: their
+    goals and paths (:class:`pegame.navigation.goals.GoalPaths`) and the candidate cells
+    of each connected component the evaders stand in, kept in one pool where a
+    component's tiles are found by their offsets."""
 
     def __init__(self, config: Any, context: Context, num_games: int) -> None:
         # The strategy itself holds the search, the planner and the follower's gains.
         self.strategy = SmartEvader(config, context, np.random.default_rng(0))
         self.grid = context.grid
-        self.goal_cell = np.full(num_games, -1, dtype=np.int64)
-        self.has_goal = np.zeros(num_games, dtype=np.bool_)
-        self.path_length = np.zeros(num_games, dtype=np.int64)
-        self.progress = np.zeros(num_games)
-        self.done = np.ones(num_games, dtype=np.bool_)
-        self.waypoints = np.zeros((num_games, FIRST_CAPACITY, 2))
-        self.seg_len = np.zeros((num_games, FIRST_CAPACITY))
-        self.arc = np.zeros((num_games, FIRST_CAPACITY))
+        self.paths = GoalPaths(
+            context.grid, self.strategy.planner, PathFollower(context.evader), num_games
+        )
         self.component = np.zeros(num_games, dtype=np.int64)
         self._labels: dict[int, int] = {}  # planner label -> component index
         self._components: list[tuple] = []  # their (cells, tiles) kernel inputs
         self._pool: tuple = ()
-        search, planner, follower = (
-            self.strategy.search,
-            self.strategy.planner,
-            self.strategy.follower,
-        )
-        sight, rays, half_widths = search.view_inputs()
-        grid = context.grid
-        self._search = (sight, rays, half_widths, grid.kernel_frame, grid.width, search.scratch())
-        self._planner = planner.search_tables()
-        self._follower = (
-            (
-                follower.lookahead,
-                follower.goal_tolerance,
-                follower.rotate_threshold,
-                follower.turn_gain,
-            ),
-            (follower.body.v_max, follower.body.w_max),
-        )
-
-    def _grow(self) -> None:
-        """Twice the room for waypoints per game, keeping the paths held."""
-        held = self.waypoints.shape[1]
-        games = self.goal_cell.size
-        waypoints, seg_len, arc = (
-            np.zeros((games, 2 * held, 2)),
-            np.zeros((games, 2 * held)),
-            np.zeros((games, 2 * held)),
-        )
-        waypoints[:, :held], seg_len[:, :held], arc[:, :held] = (
-            self.waypoints,
-            self.seg_len,
-            self.arc,
-        )
-        self.waypoints, self.seg_len, self.arc = waypoints, seg_len, arc
+        search, grid = self.strategy.search, context.grid
+        self._search = (*search.view_inputs(), grid.kernel_frame, grid.width, search.scratch())
 
     def reset(self, game: int) -> None:
         """Game ``game`` starts: no goal, no path."""
-        self.goal_cell[game], self.has_goal[game] = -1, False
-        self.path_length[game], self.progress[game], self.done[game] = 0, 0.0, True
+        self.paths.reset(game)
 
     def command(
         self, poses: np.ndarray, commands: np.ndarray, games: np.ndarray, deciding: np.ndarray
@@ -129,16 +78,14 @@ class SmartEvaderBatch:
                 self.component,
                 self._pool,
                 self._search,
-                self._planner,
-                self._follower,
-                (self.goal_cell, self.has_goal, self.path_length, self.progress, self.done),
-                (self.waypoints, self.seg_len, self.arc),
+                self.paths.world,
+                self.paths.state,
             )
             if stop < 0:
                 return
             # A path longer than the room: grow it and decide that game again.
             start += int(stop)
-            self._grow()
+            self.paths.grow()
 
     def _find_components(self, poses: np.ndarray, games: np.ndarray) -> None:
         """Point each game of ``games`` at the component of the cell its evader's plan
@@ -150,7 +97,7 @@ class SmartEvaderBatch:
         x, y = poses[games, 1, 0], poses[games, 1, 1]
         rows, cols = grid.world_to_cell(x, y)
         rows, cols = np.clip(rows, 0, grid.height - 1), np.clip(cols, 0, grid.width - 1)
-        nearest = self._planner[4]
+        nearest = self.paths.world[2][4]  # the planner's start cells
         rows, cols = nearest[0, rows, cols], nearest[1, rows, cols]
         labels = strategy.planner.labels[rows, cols]
         for k, label in enumerate(labels.tolist()):
@@ -191,23 +138,16 @@ def _play(
     component: np.ndarray,
     pool: tuple,
     search: tuple,
-    planner: tuple,
-    follower: tuple,
-    plans: tuple,
-    paths: tuple,
+    world: tuple,
+    state: tuple,
 ) -> int:
     """:meth:`SmartEvaderBatch.command`'s kernel: -1 when every game is commanded, else
-    the position in ``games`` of the first game whose new path did not fit (its state
-    and command untouched, those after it too)."""
+    the position in ``games`` of the first game whose new path did not fit the room (its
+    goal and command untouched, those after it too). world, state: the games'
+    :class:`GoalPaths` kernel inputs."""
     starts, rows, cols, boxes, group_boxes, group_starts, members = pool[:7]
     cell_offsets, tile_offsets, group_offsets = pool[7:]
     sight, rays, half_widths, frame, width, scratch = search
-    lattice, heuristic, astar_scratch, traversable, nearest = planner
-    gains, limits = follower
-    goal_cell, has_goal, path_length, progress, done = plans
-    waypoints, seg_len, arc = paths
-    height = traversable.shape[0]
-    padded_width = lattice[3]
     for k in range(games.size):
         game = games[k]
         px, py, heading = poses[game, 0, 0], poses[game, 0, 1], poses[game, 0, 2]
@@ -223,49 +163,7 @@ def _play(
             agents = (ex, ey, px, py, heading)
             tiles = (boxes[t0:t1], groups)
             cell, _ = escape_goal(cells, tiles, sight, rays, half_widths, agents, scratch)
-            if cell >= 0 and _needs_path(cell, goal_cell[game], path_length[game], width):
-                row, col = point_cell(ex, ey, frame)
-                row, col = min(max(row, 0), height - 1), min(max(col, 0), width - 1)
-                start_row, start_col = nearest[0, row, col], nearest[1, row, col]
-                goal_row, goal_col = cell // width, cell % width
-                _, route, _ = astar(
-                    lattice,
-                    (start_row + 1) * padded_width + start_col + 1,
-                    (goal_row + 1) * padded_width + goal_col + 1,
-                    heuristic,
-                    astar_scratch,
-                )
-                count = route.size + 1
-                if count > waypoints.shape[1]:
-                    return k
-                for i in range(route.size):
-                    r, q = route[i] // padded_width, route[i] % padded_width
-                    waypoints[game, i, 0], waypoints[game, i, 1] = _cell_centre(r - 1, q - 1, frame)
-                gx, gy = _cell_centre(goal_row, goal_col, frame)
-                waypoints[game, route.size, 0], waypoints[game, route.size, 1] = gx, gy
-                arc[game, 0] = 0.0
-                for i in range(count - 1):
-                    dx = waypoints[game, i + 1, 0] - waypoints[game, i, 0]
-                    dy = waypoints[game, i + 1, 1] - waypoints[game, i, 1]
-                    seg_len[game, i] = np.hypot(dx, dy)
-                    arc[game, i + 1] = arc[game, i] + seg_len[game, i]
-                path_length[game], progress[game], done[game] = count, 0.0, False
-                goal_cell[game], has_goal[game] = cell, True
-        v, w = 0.0, 0.0
-        if has_goal[game] and not done[game]:
-            n = path_length[game]
-            path = (waypoints[game, :n], seg_len[game, : n - 1], arc[game, :n])
-            v, w, progress[game], done[game] = follow_command(
-                path, progress[game], gains, limits, (ex, ey, theta)
-            )
-        commands[game, 1, 0], commands[game, 1, 1] = v, w
+            if cell >= 0 and steer(game, cell, ex, ey, world, state) < 0:
+                return k
+        commands[game, 1, 0], commands[game, 1, 1] = command(game, ex, ey, theta, world, state)
     return -1
-
-
-@njit(cache=True, inline="always")
-def _needs_path(cell: int, goal: int, length: int, width: int) -> bool:
-    """SmartEvader._needs_replan: no path, or ``cell`` more than one cell (Chebyshev) from
-    the ``goal`` cell being followed (flat indices on a grid ``width`` cells wide)."""
-    if goal < 0 or length == 0:
-        return True
-    return max(abs(cell // width - goal // width), abs(cell % width - goal % width)) > 1

@@ -43,15 +43,19 @@ def cell_centres(cells: np.ndarray, width: int, frame: tuple) -> np.ndarray:
     :meth:`OccupancyGrid.cell_to_world` in its order (the same floats), in one pass instead
     of its several numpy passes."""
     out = np.empty((cells.size, 2))
-    resolution = frame[RESOLUTION]
     for k in range(cells.size):
         row = cells[k] // width
-        col = cells[k] - row * width
-        u = (col + 0.5) * resolution
-        v = (row + 0.5) * resolution
-        if frame[ROTATED]:
-            c, s = frame[COS_YAW], frame[SIN_YAW]
-            u, v = c * u - s * v, s * u + c * v
-        out[k, 0] = u + frame[OX]
-        out[k, 1] = v + frame[OY]
+        out[k, 0], out[k, 1] = cell_centre(row, cells[k] - row * width, frame)
     return out
+
+
+@njit(cache=True, inline="always")
+def cell_centre(row: int, col: int, frame: tuple) -> tuple[float, float]:
+    """Map-frame centre (x, y) (m) of cell (row, col), by the operations of
+    :meth:`OccupancyGrid.cell_to_world` (so the same floats)."""
+    u = (float(col) + 0.5) * frame[RESOLUTION]
+    v = (float(row) + 0.5) * frame[RESOLUTION]
+    if frame[ROTATED]:
+        c, s = frame[COS_YAW], frame[SIN_YAW]
+        u, v = c * u - s * v, s * u + c * v
+    return u + frame[OX], v + frame[OY]

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from pegame.envs.vector import vector_env
-from pegame.evaders import smart_batch
 from pegame.evaders.smart import SmartEvader
+from pegame.navigation import goals
 from pegame.vector.opponents import SmartEvaderOpponent, StrategyOpponent
 
 
@@ -35,9 +35,9 @@ def test_the_batched_smart_evader_moves_as_the_strategy(overrides):
 def test_paths_longer_than_the_room_grow_it(monkeypatch):
     """Room for 4 waypoints at first: most new paths grow it, mid-tick, with the games
     before the one that did not fit already commanded."""
-    monkeypatch.setattr(smart_batch, "FIRST_CAPACITY", 4)
+    monkeypatch.setattr(goals, "FIRST_CAPACITY", 4)
     env = assert_moves_as_the_strategy(["env=enclosed", "game.t_max=20"], n=4)
-    assert env.game.opponent.batch.waypoints.shape[1] > 4
+    assert env.game.opponent.batch.paths.waypoints.shape[1] > 4
 
 
 def assert_moves_as_the_strategy(overrides, n):
@@ -55,7 +55,7 @@ def assert_moves_as_the_strategy(overrides, n):
         for got, want in zip(out_b[:4], out_s[:4]):
             np.testing.assert_array_equal(got, want)
         np.testing.assert_array_equal(batched.game.state.poses, strategy.game.state.poses)
-        decided += int(batched.game.opponent.batch.has_goal.sum())
+        decided += int((batched.game.opponent.batch.paths.goal_cell >= 0).sum())
     assert decided > 0  # the evaders had goals to follow, not only stops
     return batched
 
