@@ -50,7 +50,8 @@ When no cell within the horizon lies outside V, every reachable cell outside V i
 candidate; when V covers every reachable cell, every reachable cell is (the evader then
 runs from the pursuer). Ties go to the lowest row-major cell index (np.argmin). The
 evader replans when the chosen cell moves by more than one cell (Chebyshev) from the one
-it follows, and follows the path with :class:`pegame.navigation.PathFollower`.
+it follows, and follows the path by pure pursuit (both by
+:class:`pegame.navigation.goals.GoalPaths`, as the smart evader does).
 
 Units and frames: metres and radians in the map frame of :mod:`pegame.grid` (x right, y
 up, row 0 = lowest y). Candidates are cell centres. Everything is vectorised numpy over
@@ -70,7 +71,8 @@ from scipy.ndimage import maximum_filter
 from pegame.api import Context, Evader, EvaderObservation
 from pegame.errors import require
 from pegame.navigation import PathFollower, Planner
-from pegame.types import STOP, Plan, Pose, Region, Velocity
+from pegame.navigation.goals import GoalPaths
+from pegame.types import Plan, Pose, Region, Velocity
 from pegame.visibility.region import whole_region
 
 
@@ -125,7 +127,9 @@ class ElusiveEvader(Evader):
         grid = context.grid
         self.planner = Planner.shared(grid, context.evader.radius)
         self.pursuer_planner = Planner.shared(grid, context.pursuer.radius)
-        self.follower = PathFollower(context.evader)
+        #: the goal followed and its path (pegame.navigation.goals); goals are reachable
+        #: cells (finite evader distances), as GoalPaths needs
+        self.paths = GoalPaths(grid, self.planner, PathFollower(context.evader), 1)
         # The pursuer's camera turned all the way round: what it sees without moving.
         self._all_round = dataclasses.replace(
             context.camera, fov=2 * math.pi, angle_step=config.sight_angle_step
@@ -137,8 +141,7 @@ class ElusiveEvader(Evader):
 
     def reset(self, pose: Pose) -> None:
         self.plan = Plan()
-        self._goal_cell: tuple[int, int] | None = None
-        self.follower.set_path(np.zeros((0, 2)))
+        self.paths.reset(0)
 
     def decide(self, observation: EvaderObservation) -> Plan:
         """Choose the goal cell for this tick (module docstring); replan when it moved by
@@ -148,19 +151,16 @@ class ElusiveEvader(Evader):
         if not np.isfinite(cost).any():
             return self.plan  # nowhere to go: keep the current plan
         cell = int(np.argmin(cost))
-        goal_cell = divmod(cell, self.context.grid.width)
         goal, path = self.plan.goal, self.plan.path
-        if self._needs_replan(goal_cell):
-            x, y = self.context.grid.cell_to_world(*goal_cell)
-            goal = (float(x), float(y))
-            path = self.planner.plan((me.x, me.y), goal).path
-            self.follower.set_path(path)
-            self._goal_cell = goal_cell
+        if self.paths.steer(0, cell, me.x, me.y):
+            x, y = self.context.grid.cell_to_world(*divmod(cell, self.context.grid.width))
+            goal, path = (float(x), float(y)), self.paths.path(0)
         self.plan = Plan(goal, path, {"cost": float(cost.flat[cell])})
         return self.plan
 
     def control(self, observation: EvaderObservation) -> Velocity:
-        return self.follower.command(observation.pose) if self.plan.goal is not None else STOP
+        pose = observation.pose
+        return Velocity(*self.paths.command(0, pose.x, pose.y, pose.theta))
 
     def costs(self, me: Pose, pursuer: Pose, region: Region | None = None) -> np.ndarray:
         """Float (H * W,): each cell's cost (s, module docstring) by flat row-major index,
@@ -218,10 +218,3 @@ class ElusiveEvader(Evader):
             mask[r0:r1, c0:c1], size=2 * reach + 1, mode="constant"
         )
         return grown
-
-    def _needs_replan(self, cell: tuple[int, int]) -> bool:
-        """True when there is no path to follow or ``cell`` is more than one cell
-        (Chebyshev) from the goal being followed."""
-        if self._goal_cell is None or len(self.follower.path) == 0:
-            return True
-        return max(abs(cell[0] - self._goal_cell[0]), abs(cell[1] - self._goal_cell[1])) > 1
