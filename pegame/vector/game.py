@@ -14,8 +14,9 @@ step of ``advance``:
 =====================================  =====================================================
 TickLoop.advance                       BatchedGame.step (per control tick)
 =====================================  =====================================================
-opponent observes; decides at a        opponent.command (a strategy per game, in Python),
-decision tick; gives its command       or the kernel reads the opponent's action table
+opponent observes; decides at a        opponent.command (the smart evader's batch kernel,
+decision tick; gives its command       or a strategy per game in Python), or the tick
+                                       kernel reads the opponent's action table
 metrics.add(current tick)              kernels.tally
 _integrate: substeps, pursuer then     sims.grid.move(pursuer), sims.grid.move(evader), per
 evader (GridSimulator.step)            substep (the simulator's own kernel)
