@@ -53,7 +53,7 @@ from pegame.grid.cells import cell_centre, cell_centres
 from pegame.navigation import Planner
 from pegame.types import Camera, Pose, Region
 from pegame.visibility import VisibilityRegion, visibility_region
-from pegame.visibility.lazy import Rays, Sight, rays_reaching
+from pegame.visibility.lazy import rays_reaching, sight_and_rays
 from pegame.visibility.rays import directions, ray_tables
 from pegame.visibility.region import march_ray
 
@@ -697,19 +697,8 @@ class EscapeSearch:
     def view_inputs(self) -> tuple[tuple, tuple, np.ndarray]:
         """:func:`escape_goal`'s (sight, rays, half_widths): the grid, the pursuer's
         camera and the hide margin as the kernel takes them."""
-        grid, camera = self.grid, self.camera
-        angles, distances, first = ray_tables(camera)
-        rays = Rays(
-            angles,
-            distances,
-            first,
-            camera.angle_step,
-            camera.distance_step,
-            camera.fov,
-            camera.far,
-        )
-        sight = Sight(grid.blocked, grid.kernel_frame, float(grid.origin[2]))
-        return tuple(sight), tuple(rays), self._half_widths
+        sight, rays = sight_and_rays(self.grid, self.camera)
+        return sight, rays, self._half_widths
 
     def scratch(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:func:`escape_goal`'s scratch memory for this search's grid and camera, made at
