@@ -642,7 +642,7 @@ class EscapeSearch:
         grid = self.grid
         if visible is None:
             visible = VisibilityRegion(grid, pursuer, self.camera)
-        component = self._component_at(me)
+        component = self.component_at(me)
         exposed, top, left = self._exposed(visible)
         skipped = _exposed_positions(exposed, top, left, grid.width, component.position)
         count = component.cells.size - skipped.size
@@ -679,7 +679,7 @@ class EscapeSearch:
         looks (:func:`escape_goal`; Euclidean distances only)."""
         if self.distance != "euclidean":
             raise ValueError("EscapeSearch.goal computes Euclidean distances only.")
-        component = self._component_at(me)
+        component = self.component_at(me)
         agents = (me.x, me.y, pursuer.x, pursuer.y, pursuer.theta)
         cells, tiles, sight, rays, half_widths = self.kernel_inputs(component)
         cell, cost = escape_goal(cells, tiles, sight, rays, half_widths, agents, self.scratch())
@@ -760,7 +760,7 @@ class EscapeSearch:
         grid = self.grid
         return cell_centres(cells.ravel(), grid.width, grid.kernel_frame).reshape(*cells.shape, 2)
 
-    def _component_at(self, me: Pose) -> _Component:
+    def component_at(self, me: Pose) -> _Component:
         """The candidate cells of the evader's connected component: the one last used when
         the cell the planner starts from (the evader's, or the nearest traversable one)
         lies in it, else one built for an earlier game on this map (components are

@@ -103,7 +103,7 @@ class SmartEvaderBatch:
         for k, label in enumerate(labels.tolist()):
             if label not in self._labels:
                 pose = Pose(float(x[k]), float(y[k]), 0.0)
-                self._add(label, strategy.search._component_at(pose))
+                self._add(label, strategy.search.component_at(pose))
             self.component[games[k]] = self._labels[label]
 
     def _add(self, label: int, component: Any) -> None:
