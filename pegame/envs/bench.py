@@ -93,6 +93,9 @@ def _vector_steps_per_second(
 
 #: rounds of the batched env timed before any other batched env exists in the process
 ALONE_ROUNDS = 5
+#: untimed rounds before those: without them the env read 1.17x and 1.19x faster beside
+#: the others than alone (two runs, AMD EPYC), with them 1.08x
+WARM_ROUNDS = 3
 
 #: the paper's conditions as a batched env plays them (no env plays the paper's turns)
 PAPER_CONDITIONS = ("+experiment=paper_conditions", "game.turn_order=simultaneous")
@@ -150,7 +153,8 @@ def bench_vector_env(
     Figures are medians over the rounds; ``vector_speedup_per_core`` is the median of the
     rounds' ratios to the single env. ``vector_beside_others_ratio``: the batched env's
     one-core rate in those rounds (the smart opponents' envs alive beside it) over its rate
-    in ALONE_ROUNDS rounds before they were built; ``vector_scaling_over_smaller``: its rate
+    in ALONE_ROUNDS rounds before they were built (after WARM_ROUNDS untimed ones);
+    ``vector_scaling_over_smaller``: its rate
     over the rate of an env of ``scaling_base`` games (``num_envs_smaller``, 1024) in the
     same rounds (None at that many games or fewer).
     ``settings``: env options (:class:`pegame.observe.settings.EnvSettings`) for both.
@@ -184,7 +188,9 @@ def bench_vector_env(
     memory = (_rss_bytes() - before) / num_envs
     arrays = _array_bytes(env) / num_envs
     batch = 4
-    played = 1 + ALONE_ROUNDS * batch
+    for _ in range(WARM_ROUNDS):  # untimed: the first rounds touch the state's pages
+        _vector_steps_per_second(env, np.zeros((batch, num_envs, 2), np.float32), 1)
+    played = 1 + (WARM_ROUNDS + ALONE_ROUNDS) * batch
     alone = [
         _vector_steps_per_second(
             env, rng.uniform(-1.0, 1.0, (batch, num_envs, 2)).astype(np.float32), 1
