@@ -295,24 +295,24 @@ def escape_goal(
 ) -> tuple[int, float]:
     """Algorithm 2's argmin (flat cell, cost; (-1, inf) without a candidate) for the
     evader and the pursuer at ``agents`` (ex, ey, px, py, pursuer heading) (m, rad), over
-    a component's tiled ``cells`` (:class:`TiledCells`) with its ``tiles``: (boxes (T, 4),
-    groups) as :meth:`EscapeSearch.kernel_inputs` gives them,
-    computing the pursuer's visibility region only where the search looks: the goal and
-    cost of :meth:`EscapeSearch.escape` without its count and sample of the candidates.
+    a component's tiled ``cells`` (:class:`TiledCells`) with its ``tiles`` (boxes (T, 4),
+    groups), as :meth:`EscapeSearch.kernel_inputs` gives them, computing the pursuer's
+    visibility region only where the search looks: the goal and cost of
+    :meth:`EscapeSearch.escape` without its count and sample of the candidates.
 
     Tiles are scored in increasing bound from a heap, as far as :func:`_best_candidate`
     scores them (its argmin does not depend on the order of equal bounds: every tile whose
     bound is within the slack of the final cost is scored). The heap starts with groups
     of GROUP x GROUP tiles (:func:`_group_tiles`) under their box's bound, no larger than
     their tiles' bounds; a group popped puts its tiles in, so the bounds of most tiles
-    are never computed. For a tile, V grown by the
-    hide margin (``half_widths``, :func:`disc_half_widths`) is only needed on its cells,
-    so V is needed on the tile's block grown by the margin: the rays that can reach that
-    block as far as they can reach it (:func:`pegame.visibility.lazy.rays_reaching`),
-    marched as the whole region marches them (:func:`pegame.visibility.region.march_ray`)
-    and kept for later tiles. A ray marks the same cells whichever others are marched,
-    so on the block the marks are the whole region's. A tile whose block no ray reaches,
-    or that holds no mark, has no cell in grown V.
+    are never computed. For a tile, V grown by the hide margin (``half_widths``,
+    :func:`disc_half_widths`) is only needed on its cells, so V is needed on the tile's
+    block grown by the margin: the rays that can reach that block, as far as they can
+    reach it (:func:`pegame.visibility.lazy.rays_reaching`), marched as the whole region
+    marches them (:func:`pegame.visibility.region.march_ray`) and kept for later tiles. A
+    ray marks the same cells whichever others are marched, so on the block the marks are
+    the whole region's. A tile whose block no ray reaches, or that holds no mark, has no
+    cell in grown V.
 
     sight: (blocked (H, W), kernel_frame, grid yaw) as :class:`pegame.visibility.lazy.Sight`;
     rays: the camera's :class:`pegame.visibility.lazy.Rays`; scratch: (bool (H, W) all
