@@ -4,6 +4,7 @@ first use, so that ``python -m pegame.bench`` formats its report without them.""
 
 from __future__ import annotations
 
+import gc
 import math
 import os
 import statistics
@@ -91,7 +92,8 @@ def _vector_steps_per_second(
     return actions.shape[0] * env.num_envs / (time.perf_counter() - start)
 
 
-#: rounds of the batched env timed before any other batched env exists in the process
+#: rounds of the batched env timed before any other batched env exists in the process,
+#: and as many after they are deleted
 ALONE_ROUNDS = 5
 #: untimed rounds before those: without them the env read 1.17x and 1.19x faster beside
 #: the others than alone (two runs, AMD EPYC), with them 1.08x
@@ -153,8 +155,9 @@ def bench_vector_env(
     Figures are medians over the rounds; ``vector_speedup_per_core`` is the median of the
     rounds' ratios to the single env. ``vector_beside_others_ratio``: the batched env's
     one-core rate in those rounds (the smart opponents' envs alive beside it) over its rate
-    in ALONE_ROUNDS rounds before they were built (after WARM_ROUNDS untimed ones);
-    ``vector_scaling_over_smaller``: its rate
+    in ALONE_ROUNDS rounds before they were built (after WARM_ROUNDS untimed ones) and
+    ALONE_ROUNDS after they were deleted (so that the env's drift over the run falls on
+    both sides); ``vector_scaling_over_smaller``: its rate
     over the rate of an env of ``scaling_base`` games (``num_envs_smaller``, 1024) in the
     same rounds (None at that many games or fewer).
     ``settings``: env options (:class:`pegame.observe.settings.EnvSettings`) for both.
@@ -214,7 +217,8 @@ def bench_vector_env(
     per_round: dict[str, list[float]] = {"single": [], "core": [], "all": [], "smaller": []}
     per_round.update({key: [] for key in smart})
     deadline = time.perf_counter() + seconds
-    while time.perf_counter() < deadline and played + 3 * batch < env.game.steps:
+    after = ALONE_ROUNDS * batch  # the steps the alone rounds after the others need
+    while time.perf_counter() < deadline and played + 3 * batch + after < env.game.steps:
         single.reset(seed=seed + played)
         pairs = rng.uniform(-1.0, 1.0, (single_steps, 2, 2)).astype(np.float32)
         start = time.perf_counter()
@@ -230,6 +234,14 @@ def bench_vector_env(
         for key, periods in smart.items():
             per_round[key].append(periods.steps_per_second(rng))
         played += 3 * batch
+    del smart, smaller  # the other envs gone, the env alone again, at the end as at the start
+    gc.collect()
+    alone += [
+        _vector_steps_per_second(
+            env, rng.uniform(-1.0, 1.0, (batch, num_envs, 2)).astype(np.float32), 1
+        )
+        for _ in range(ALONE_ROUNDS)
+    ]
     numba.set_num_threads(threads)
     single.close()
     median = {key: statistics.median(values) for key, values in per_round.items() if values}
