@@ -1,11 +1,13 @@
-"""Whole games of the batched pursuit env against the smart evader, one core: the evader
-batched in the kernels (``batch``) or played game by game in Python as any strategy
-(``strategy``); env steps per second of CPU time over every step of one game (enclosed,
-random actions for the pursuer), and per block of 100 steps (the first, with most evaders
-in view and every game planning, is the slowest).
+"""Whole games of the batched pursuit env against the smart evader: the evader batched in
+the kernels (``batch``) or played game by game in Python as any strategy (``strategy``);
+env steps per second over every step of one game (enclosed, random actions for the
+pursuer), and per block of 100 steps (the first, with most evaders in view and every game
+planning, is the slowest). On one numba thread (the default) the rates are per second of
+CPU time, on more (a third argument) per second of wall time.
 
     python docs/performance/smart_evader_games.py 1024 batch
     python docs/performance/smart_evader_games.py 256 strategy
+    python docs/performance/smart_evader_games.py 1024 batch 2
 """
 
 import sys
@@ -18,9 +20,11 @@ from pegame.envs.vector import vector_env
 from pegame.evaders.smart import SmartEvader
 from pegame.vector.opponents import StrategyOpponent
 
-numba.set_num_threads(1)
 n = int(sys.argv[1])
 which = sys.argv[2]
+threads = int(sys.argv[3]) if len(sys.argv) > 3 else 1
+numba.set_num_threads(threads)
+clock = time.process_time if threads == 1 else time.perf_counter
 env = vector_env(n, overrides=["env=enclosed"], opponent="smart")
 if which == "strategy":
     game = env.game
@@ -32,13 +36,14 @@ rng = np.random.default_rng(0)
 steps = env.game.steps - 1
 acts = rng.uniform(-1, 1, (steps, n, 2)).astype(np.float32)
 phase = []
-t0 = t = time.process_time()
+t0 = t = clock()
 for i, actions in enumerate(acts):
     env.step(actions)
     if i % 100 == 99:
-        now = time.process_time()
+        now = clock()
         phase.append(100 * n / (now - t))
         t = now
-total = time.process_time() - t0
+total = clock() - t0
 blocks = " ".join(f"{p / 1e3:.0f}k" for p in phase)
-print(f"{which}, {n} games: {steps * n / total:.0f} steps/s over a whole game; per 100: {blocks}")
+rate = f"{steps * n / total:.0f} steps/s over a whole game on {threads} thread(s)"
+print(f"{which}, {n} games: {rate}; per 100: {blocks}")

@@ -10,6 +10,11 @@ the same kernels, so each game's commands are the strategy's, bit for bit:
 - the goal followed, its path and the command at every tick by the kernels of
   :mod:`pegame.navigation.goals`, which the strategy calls for its batch of one.
 
+The games are spread over as many threads as numba is set to use (its kernel releases
+the GIL; at least MIN_GAMES_PER_THREAD games a thread), each thread with the escape
+search's and A*'s scratch memory of its own; a game's commands do not depend on the
+threads (a test plays one thread against two).
+
 Not kept: the plan's info (the recorded candidates and the escape cost) and the INFO log
 when no candidate exists, which a recorder and a log read; a batched game has neither.
 Geodesic distances are not batched (:func:`batchable`).
@@ -19,8 +24,10 @@ Units and frames: metres, seconds and radians in the map frame of :mod:`pegame.g
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
+import numba
 import numpy as np
 from numba import njit
 
@@ -30,6 +37,9 @@ from pegame.evaders.smart import SmartEvader
 from pegame.navigation import PathFollower
 from pegame.navigation.goals import GoalPaths, command, steer
 from pegame.types import Pose
+
+#: games a thread is given at least: below, starting a thread costs more than it saves
+MIN_GAMES_PER_THREAD = 32
 
 
 def batchable(config: Any) -> bool:
@@ -55,7 +65,13 @@ class SmartEvaderBatch:
         self._components: list[tuple] = []  # their (cells, tiles) kernel inputs
         self._pool: tuple = ()
         search, grid = self.strategy.search, context.grid
-        self._search = (*search.view_inputs(), grid.kernel_frame, grid.width, search.scratch())
+        # The grid's frame as a float64 array: a tuple of mixed types cannot enter numba's
+        # parallel loops (the same numbers, so the same cells and centres).
+        frame = np.asarray(grid.kernel_frame, dtype=np.float64)
+        (blocked, _, yaw), rays, half_widths = search.view_inputs()
+        self._search = ((blocked, frame, yaw), rays, half_widths, frame, grid.width)
+        self._scratch: tuple | None = None  # per thread, see _thread_scratch
+        self._threads: tuple[ThreadPoolExecutor, int] | None = None
 
     def reset(self, game: int) -> None:
         """Game ``game`` starts: no goal, no path."""
@@ -66,26 +82,49 @@ class SmartEvaderBatch:
     ) -> None:
         """Write the evader's (v, w) of ``games`` into commands[game, 1], deciding first
         where ``deciding``; poses, commands: (N, 2, 3) and (N, 2, 2), role 0 the
-        pursuer."""
+        pursuer. The games are spread over numba's threads, each with scratch memory of
+        its own."""
         self._find_components(poses, games[deciding])
-        start = 0
-        while start < games.size:
-            stop = _play(
-                games[start:],
-                deciding[start:],
-                poses,
-                commands,
-                self.component,
-                self._pool,
-                self._search,
-                self.paths.world,
-                self.paths.state,
+        threads = max(1, min(numba.get_num_threads(), games.size // MIN_GAMES_PER_THREAD))
+        scratch = self._thread_scratch(threads)
+        while games.size:
+            unplayed = np.zeros(games.size, dtype=np.bool_)
+            arguments = (games, deciding, poses, commands, self.component, self._pool)
+            state = (self._search, self.paths.world, self.paths.state, scratch, unplayed)
+            if threads == 1:
+                _play(*arguments, *state, (0, 1))
+            else:
+                executor = self._executor(threads)
+                chunks = [
+                    executor.submit(_play, *arguments, *state, (c, threads)) for c in range(threads)
+                ]
+                for chunk in chunks:
+                    chunk.result()
+            # A new path longer than the room: grow it and play those games again.
+            games, deciding = games[unplayed], deciding[unplayed]
+            if games.size:
+                self.paths.grow()
+
+    def _executor(self, threads: int) -> ThreadPoolExecutor:
+        """A pool of ``threads`` threads, kept while that many are asked for."""
+        if self._threads is None or self._threads[1] != threads:
+            if self._threads is not None:
+                self._threads[0].shutdown()
+            pool = ThreadPoolExecutor(threads, thread_name_prefix="smart-evader")
+            self._threads = (pool, threads)
+        return self._threads[0]
+
+    def _thread_scratch(self, threads: int) -> tuple:
+        """The escape search's and A*'s scratch memory, one slice per thread (the first
+        axis), made for the most threads asked so far."""
+        if self._scratch is None or self._scratch[0].shape[0] < threads:
+            search = self.strategy.search.scratch()
+            astar = self.paths.world[2][2]
+            self._scratch = (
+                *(np.zeros((threads, *a.shape), dtype=a.dtype) for a in search),
+                *(np.zeros((threads, *a.shape), dtype=a.dtype) for a in astar),
             )
-            if stop < 0:
-                return
-            # A path longer than the room: grow it and decide that game again.
-            start += int(stop)
-            self.paths.grow()
+        return self._scratch
 
     def _find_components(self, poses: np.ndarray, games: np.ndarray) -> None:
         """Point each game of ``games`` at the component of the cell its evader's plan
@@ -129,7 +168,7 @@ class SmartEvaderBatch:
         )
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _play(
     games: np.ndarray,
     deciding: np.ndarray,
@@ -140,30 +179,54 @@ def _play(
     search: tuple,
     world: tuple,
     state: tuple,
-) -> int:
-    """:meth:`SmartEvaderBatch.command`'s kernel: -1 when every game is commanded, else
-    the position in ``games`` of the first game whose new path did not fit the room (its
-    goal and command untouched, those after it too). world, state: the games'
-    :class:`GoalPaths` kernel inputs."""
+    scratch: tuple,
+    unplayed: np.ndarray,
+    chunk: tuple[int, int],
+) -> None:
+    """:meth:`SmartEvaderBatch.command`'s kernel for the games at positions chunk[0],
+    chunk[0] + chunk[1], ... of ``games``, with thread slice chunk[0] of the ``scratch``:
+    each decided (where ``deciding``) and commanded; ``unplayed[k]`` set for a game whose
+    new path did not fit the room (its goal and command untouched). world, state: the
+    games' :class:`GoalPaths` kernel inputs. It releases the GIL, so chunks run on
+    threads at once; a game's result does not depend on its chunk."""
+    c, chunks = chunk
     starts, rows, cols, boxes, group_boxes, group_starts, members = pool[:7]
     cell_offsets, tile_offsets, group_offsets = pool[7:]
-    sight, rays, half_widths, frame, width, scratch = search
-    for k in range(games.size):
+    sight, rays, half_widths, frame, width = search
+    escape_scratch = (scratch[0][c], scratch[1][c], scratch[2][c])
+    astar_scratch = (
+        scratch[3][c],
+        scratch[4][c],
+        scratch[5][c],
+        scratch[6][c],
+        scratch[7][c],
+        scratch[8][c],
+        scratch[9][c],
+        scratch[10][c],
+    )
+    lattice, heuristic, _, traversable, nearest = world[2]
+    world = (
+        world[0],
+        world[1],
+        (lattice, heuristic, astar_scratch, traversable, nearest),
+        world[3],
+    )
+    for k in range(c, games.size, chunks):
         game = games[k]
         px, py, heading = poses[game, 0, 0], poses[game, 0, 1], poses[game, 0, 2]
         ex, ey, theta = poses[game, 1, 0], poses[game, 1, 1], poses[game, 1, 2]
         if deciding[k]:
-            c = component[game]
-            t0, t1 = tile_offsets[c], tile_offsets[c + 1]
-            k0, k1 = cell_offsets[c], cell_offsets[c + 1]
-            g0, g1 = group_offsets[c], group_offsets[c + 1]
-            # A component's starts are its own (T + 1,), after c earlier ones' ends.
-            cells = (starts[t0 + c : t1 + c + 1], rows[k0:k1], cols[k0:k1], frame, width)
-            groups = (group_boxes[g0:g1], group_starts[g0 + c : g1 + c + 1], members[t0:t1])
+            p = component[game]
+            t0, t1 = tile_offsets[p], tile_offsets[p + 1]
+            k0, k1 = cell_offsets[p], cell_offsets[p + 1]
+            g0, g1 = group_offsets[p], group_offsets[p + 1]
+            # A component's starts are its own (T + 1,), after p earlier ones' ends.
+            cells = (starts[t0 + p : t1 + p + 1], rows[k0:k1], cols[k0:k1], frame, width)
+            groups = (group_boxes[g0:g1], group_starts[g0 + p : g1 + p + 1], members[t0:t1])
             agents = (ex, ey, px, py, heading)
             tiles = (boxes[t0:t1], groups)
-            cell, _ = escape_goal(cells, tiles, sight, rays, half_widths, agents, scratch)
+            cell, _ = escape_goal(cells, tiles, sight, rays, half_widths, agents, escape_scratch)
             if cell >= 0 and steer(game, cell, ex, ey, world, state) < 0:
-                return k
+                unplayed[k] = True
+                continue
         commands[game, 1, 0], commands[game, 1, 1] = command(game, ex, ey, theta, world, state)
-    return -1

@@ -6,11 +6,13 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 import pytest
 
 from pegame.api import Context, EvaderObservation
 from pegame.envs.vector import vector_env
+from pegame.evaders import smart_batch
 from pegame.evaders.smart import SmartEvader
 from pegame.evaders.smart_batch import SmartEvaderBatch
 from pegame.grid import FREE, OCCUPIED, OccupancyGrid
@@ -45,6 +47,20 @@ def test_paths_longer_than_the_room_grow_it(monkeypatch):
     monkeypatch.setattr(goals, "FIRST_CAPACITY", 4)
     env = assert_moves_as_the_strategy(["env=enclosed", "game.t_max=20"], n=4)
     assert env.game.opponent.batch.paths.waypoints.shape[1] > 4
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="numba has one thread")
+def test_games_on_two_threads_move_as_the_strategy(monkeypatch):
+    """The games spread over two threads (each with its own scratch memory) move as the
+    per-game strategy does, which plays them one by one."""
+    monkeypatch.setattr(smart_batch, "MIN_GAMES_PER_THREAD", 1)
+    threads = numba.get_num_threads()
+    numba.set_num_threads(2)
+    try:
+        env = assert_moves_as_the_strategy(["env=enclosed", "game.t_max=20"], n=6)
+    finally:
+        numba.set_num_threads(threads)
+    assert env.game.opponent.batch._threads[1] == 2
 
 
 def assert_moves_as_the_strategy(overrides, n):
