@@ -65,11 +65,7 @@ class SmartEvaderBatch:
         self._components: list[tuple] = []  # their (cells, tiles) kernel inputs
         self._pool: tuple = ()
         search, grid = self.strategy.search, context.grid
-        # The grid's frame as a float64 array: a tuple of mixed types cannot enter numba's
-        # parallel loops (the same numbers, so the same cells and centres).
-        frame = np.asarray(grid.kernel_frame, dtype=np.float64)
-        (blocked, _, yaw), rays, half_widths = search.view_inputs()
-        self._search = ((blocked, frame, yaw), rays, half_widths, frame, grid.width)
+        self._search = (*search.view_inputs(), grid.kernel_frame, grid.width)
         self._scratch: tuple | None = None  # per thread, see _thread_scratch
         self._threads: tuple[ThreadPoolExecutor, int] | None = None
 

@@ -58,10 +58,9 @@ class GoalPaths:
             follower.rotate_threshold,
             follower.turn_gain,
         )
-        #: the kernels' fixed inputs: the grid (its frame as a float64 array, which
-        #: numba's parallel loops take), the planner's tables, the follower's
+        #: the kernels' fixed inputs: the grid, the planner's tables, the follower's
         self.world = (
-            np.asarray(grid.kernel_frame, dtype=np.float64),
+            grid.kernel_frame,
             grid.width,
             planner.search_tables(),
             (gains, (follower.body.v_max, follower.body.w_max)),
