@@ -144,6 +144,13 @@ def _apart(x: float, y: float, radius: float, placed: list[tuple[Pose, float]]) 
     return all(math.hypot(x - p.x, y - p.y) >= radius + r for p, r in placed)
 
 
+def member_stream(seed: int, kind: str, *index: int) -> np.random.SeedSequence:
+    """The seed sequence of a team's extra member of ``kind`` at ``index`` (a member
+    number, or a detector pair (i, j)) in the game with master seed ``seed``: a stream
+    after every 1v1 stream (spawn key ``len(STREAMS)``), so member 0 keeps the 1v1 game's."""
+    return np.random.SeedSequence(seed, spawn_key=(len(STREAMS), STREAMS.index(kind), *index))
+
+
 def spawn_team(
     context: Context, rng: np.random.Generator, pursuers: int, evaders: int, attempts: int = 200
 ) -> tuple[tuple[Pose, ...], tuple[Pose, ...]]:
@@ -444,8 +451,7 @@ class Game:
         class is the kind's own) built with the generator of ``index``: a stream after
         every 1v1 stream (spawn key ``len(STREAMS)``), so member 0 keeps the 1v1 game's
         generator."""
-        key = (len(STREAMS), STREAMS.index(kind), *index)
-        rng = np.random.default_rng(np.random.SeedSequence(self.seed, spawn_key=key))
+        rng = np.random.default_rng(member_stream(self.seed, kind, *index))
         return self._build(kind, member, rng)
 
     def start(self, external: tuple[str, ...] = (), estimate: bool = True) -> TickLoop:

@@ -199,26 +199,48 @@ class TeamMetrics:
 
     def summary(self) -> dict[str, Any]:
         """The 1v1 measures as means over the evaders, then the team's (module docstring)."""
-        summaries = [m.summary() for m in self.per_evader]
-        result: dict[str, Any] = {}
-        for key in summaries[0]:
-            values = [v for v in (s[key] for s in summaries) if v is not None]
-            result[key] = _rounded(np.mean(values)) if values else None
-        ticks = max(1, self.ticks)
-        result["tracking_rate"] = _rounded(self.tracking_rate)
-        result["pursuer_path_length"] = _rounded(
-            np.mean([_path_length(np.asarray(p)) for p in self.pursuer_paths])
-        )
-        result.update(
-            {
-                "pursuers": len(self.pursuer_paths),
-                "evaders": len(self.per_evader),
-                "tracking_rate_per_evader": [s["tracking_rate"] for s in summaries],
-                "tracking_rate_per_pursuer": [_rounded(n / ticks) for n in self.pursuer_detected],
-                "handoffs": self.handoffs,
-                "coverage": _rounded(np.mean(self.coverage)) if self.coverage else None,
-            }
+        result = team_summary(
+            [m.summary() for m in self.per_evader],
+            [m.tracking_rate for m in self.per_evader],
+            [_path_length(np.asarray(p)) for p in self.pursuer_paths],
+            self.pursuer_detected,
+            self.ticks,
+            self.handoffs,
+            self.coverage,
         )
         if self.losses is not None:
             result["loss_causes"] = self.losses.summary()
         return result
+
+
+def team_summary(
+    summaries: Sequence[dict[str, Any]],
+    tracking_rates: Sequence[float],
+    pursuer_paths: Sequence[float],
+    pursuer_detected: Sequence[int],
+    ticks: int,
+    handoffs: int,
+    coverage: Sequence[float],
+) -> dict[str, Any]:
+    """A team game's measures (:meth:`TeamMetrics.summary` but the loss causes) from each
+    evader's 1v1 ``summaries`` and unrounded ``tracking_rates``, each pursuer's path
+    length (m) and ticks detecting some evader, the ticks played, the handoffs and the
+    coverage samples (fractions of the free cells)."""
+    result: dict[str, Any] = {}
+    for key in summaries[0]:
+        values = [v for v in (s[key] for s in summaries) if v is not None]
+        result[key] = _rounded(np.mean(values)) if values else None
+    ticks = max(1, ticks)
+    result["tracking_rate"] = _rounded(float(np.mean(tracking_rates)))
+    result["pursuer_path_length"] = _rounded(np.mean(pursuer_paths))
+    result.update(
+        {
+            "pursuers": len(pursuer_paths),
+            "evaders": len(summaries),
+            "tracking_rate_per_evader": [s["tracking_rate"] for s in summaries],
+            "tracking_rate_per_pursuer": [_rounded(n / ticks) for n in pursuer_detected],
+            "handoffs": handoffs,
+            "coverage": _rounded(np.mean(coverage)) if len(coverage) else None,
+        }
+    )
+    return result

@@ -117,33 +117,41 @@ class _Batch:
     def _commands(
         self, actions: Mapping[str, ArrayLike], playing: np.ndarray
     ) -> dict[str, np.ndarray]:
-        """role -> (N, 2) (v, w) of the learners' batched ``actions`` (role -> (N, 2) in
-        [-1, 1]); ValueError for a bad one among the games playing."""
+        """role -> (N, members, 2) (v, w) of the learners' batched ``actions`` (agent ->
+        (N, 2) in [-1, 1]); ValueError for a bad one among the games playing."""
         out = {}
-        for role in self.roles:
+        for role, members in self.game.members.items():
             body = self.game.context.pursuer if role == "pursuer" else self.game.context.evader
-            a = np.asarray(actions[role])
-            if a.shape != (self.num_envs, 2):
-                raise ValueError(
-                    f"{role} actions must have shape ({self.num_envs}, 2) (v, w) in [-1, 1] "
-                    f"per env, got shape {a.shape}."
-                )
-            a = a.astype(np.float64)
-            live = a if playing.all() else a[playing]  # no copy in the common case
-            if not np.isfinite(live).all():
-                raise ValueError(
-                    f"{role} actions must be finite, got {a[playing][~np.isfinite(live).all(1)][0]!r}."
-                )
-            if np.abs(live).max(initial=0.0) > 1.0:
-                if not self.settings.clip_actions:
-                    bad = live[(np.abs(live) > 1.0).any(axis=1)][0]
-                    raise ValueError(
-                        f"{role} actions must lie in [-1, 1] (scaled v, w), got {bad!r}; "
-                        "pass clip_actions=True to clip instead."
-                    )
-                a = np.clip(a, -1.0, 1.0)
-            out[role] = a * np.array([body.v_max, body.w_max])
+            scale = np.array([body.v_max, body.w_max])
+            commands = out[role] = np.empty((self.num_envs, len(members), 2))
+            for k, agent in enumerate(members):
+                commands[:, k] = scale * self._action(agent, actions[agent], playing)
         return out
+
+    def _action(self, agent: str, action: ArrayLike, playing: np.ndarray) -> np.ndarray:
+        """``agent``'s (N, 2) scaled actions as float64, clipped when the settings say so;
+        ValueError for a bad one among the games playing."""
+        a = np.asarray(action)
+        if a.shape != (self.num_envs, 2):
+            raise ValueError(
+                f"{agent} actions must have shape ({self.num_envs}, 2) (v, w) in [-1, 1] "
+                f"per env, got shape {a.shape}."
+            )
+        a = a.astype(np.float64)
+        live = a if playing.all() else a[playing]  # no copy in the common case
+        if not np.isfinite(live).all():
+            raise ValueError(
+                f"{agent} actions must be finite, got {a[playing][~np.isfinite(live).all(1)][0]!r}."
+            )
+        if np.abs(live).max(initial=0.0) > 1.0:
+            if not self.settings.clip_actions:
+                bad = live[(np.abs(live) > 1.0).any(axis=1)][0]
+                raise ValueError(
+                    f"{agent} actions must lie in [-1, 1] (scaled v, w), got {bad!r}; "
+                    "pass clip_actions=True to clip instead."
+                )
+            a = np.clip(a, -1.0, 1.0)
+        return a
 
     def _advance(
         self, actions: Mapping[str, ArrayLike]
@@ -248,12 +256,16 @@ class EvasionVectorEnv(_LearnerVectorEnv):
 
 
 class SelfPlayVectorEnv(_Batch):
-    """Both roles learning in ``num_envs`` games: the batched PettingZoo env.
+    """Both roles learning in ``num_envs`` games: the batched PettingZoo env
+    (:mod:`pegame.envs.parallel`), 1v1 or teams.
 
-    ``reset`` and ``step`` take and return dicts keyed by agent ('pursuer', 'evader') of
-    batched arrays: observations (N, size), actions (N, 2), rewards (N,) (the evader's
-    is the pursuer's negative), terminations and truncations (N,); infos is one dict for
-    all games (as the vector envs'). Autoreset as the vector envs.
+    ``reset`` and ``step`` take and return dicts keyed by agent of batched arrays:
+    observations (N, size), actions (N, 2), rewards (N,), terminations and truncations
+    (N,); infos is one dict for all games (as the vector envs'). The agents are
+    'pursuer' and 'evader' in a 1v1 game, and ``pursuer_0`` .. ``pursuer_{P-1}``,
+    ``evader_0`` .. ``evader_{E-1}`` in a team game (``team.pursuers``, ``team.evaders``),
+    the pursuers with the team's reward and each evader with its own (the evader's is the
+    pursuer's negative in a 1v1 game). Autoreset as the vector envs.
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
@@ -267,22 +279,28 @@ class SelfPlayVectorEnv(_Batch):
         **settings: Any,
     ) -> None:
         self._setup(num_envs, config, overrides, None, ROLES, settings)
-        self.possible_agents = list(ROLES)
-        self.single_observation_spaces = {role: self._observation_space(role) for role in ROLES}
+        members = self.game.members
+        self.possible_agents = [agent for role in ROLES for agent in members[role]]
+        #: (agent, role, member index) per agent
+        self._agents = [(agent, role, k) for role in ROLES for k, agent in enumerate(members[role])]
+        self.layouts = {agent: self.game.features[role].layout for agent, role, _ in self._agents}
+        self.single_observation_spaces = {
+            agent: self._observation_space(role) for agent, role, _ in self._agents
+        }
         self.single_action_spaces = {
-            role: spaces.Box(-1.0, 1.0, (2,), np.float32) for role in ROLES
+            agent: spaces.Box(-1.0, 1.0, (2,), np.float32) for agent in self.possible_agents
         }
         self.observation_spaces = {
-            role: batch_space(space, self.num_envs)
-            for role, space in self.single_observation_spaces.items()
+            agent: batch_space(space, self.num_envs)
+            for agent, space in self.single_observation_spaces.items()
         }
         self.action_spaces = {
-            role: batch_space(space, self.num_envs)
-            for role, space in self.single_action_spaces.items()
+            agent: batch_space(space, self.num_envs)
+            for agent, space in self.single_action_spaces.items()
         }
 
     def _observations(self) -> dict[str, np.ndarray]:
-        return {role: self.game.observations(role) for role in ROLES}
+        return {agent: self.game.observations(role, k) for agent, role, k in self._agents}
 
     def reset(
         self, *, seed: Seeds = None, options: dict[str, Any] | None = None
@@ -300,16 +318,26 @@ class SelfPlayVectorEnv(_Batch):
         dict[str, np.ndarray],
         dict[str, Any],
     ]:
-        """One decision period of every game with both agents' (N, 2) actions."""
-        if not isinstance(actions, dict) or sorted(actions) != sorted(ROLES):
-            raise ValueError(f"actions must map each agent in {list(ROLES)} to its (N, 2) actions.")
-        rewards, ended, infos = self._advance(actions)
+        """One decision period of every game with every agent's (N, 2) actions."""
+        if not isinstance(actions, dict) or sorted(actions) != sorted(self.possible_agents):
+            raise ValueError(
+                f"actions must map each agent in {self.possible_agents} to its (N, 2) actions."
+            )
+        detections, ended, infos = self._advance(actions)
+        if detections.ndim == 1:  # a 1v1 game
+            rewards = {"pursuer": detections, "evader": -detections}
+        else:
+            team = detections.sum(axis=1)
+            rewards = {agent: team.copy() for agent in self.game.members["pursuer"]}
+            for j, agent in enumerate(self.game.members["evader"]):
+                rewards[agent] = -detections[:, j]
         never = np.zeros(self.num_envs, np.bool_)
+        agents = self.possible_agents
         return (
             self._observations(),
-            {"pursuer": rewards, "evader": -rewards},
-            dict.fromkeys(ROLES, never),
-            dict.fromkeys(ROLES, ended),
+            rewards,
+            dict.fromkeys(agents, never),
+            dict.fromkeys(agents, ended),
             infos,
         )
 

@@ -14,12 +14,12 @@ the pipeline's schedule (:func:`pegame.detectors.perception.frame_due`,
 - :func:`detect` is the oracle detector's capture
   (:class:`pegame.detectors.oracle.OracleDetector`) for the parts the batched game plays:
   the evader's centre in view and in the detection range, the range and occlusion misses
-  drawn from each game's 'range' stream drawn ahead (state.draws), the detection into the
-  game's rows of the state;
-- :func:`sense` is the loop's ``_sense`` (detection, then in_view) with the pursuer
-  observation's memory of the last detection; the detection goes through the perception
-  model's pipeline (rate and latency) when it runs, the results in flight in the state's
-  arrays.
+  drawn from each detector pair's 'range' stream drawn ahead (state.draws), the detection
+  into the pair's rows of the state;
+- :func:`sense` is the loop's ``_sense`` (each pair's detection, then in_view) with the
+  pursuer observations' memory of the last detection; a detection goes through the
+  perception model's pipeline (rate and latency) when it runs, the results in flight in
+  the state's arrays.
 
 ``tests/vector/test_kernels.py`` and ``tests/envs`` compare them with the plain code.
 Units: SI, map frame.
@@ -40,7 +40,6 @@ from pegame.vector.state import (
     BOX_Y,
     DEPTH,
     DETECTION_RANGE,
-    EVADER,
     FAR,
     FOV,
     LATENCY,
@@ -51,7 +50,6 @@ from pegame.vector.state import (
     OCCLUSION_MISS,
     PERIOD,
     PIPELINE,
-    PURSUER,
     RADIUS,
     RATED,
     SEEN_X,
@@ -71,24 +69,27 @@ def detect(
     camera: np.ndarray,
     perception: np.ndarray,
     radius: float,
-    poses: np.ndarray,
+    cx: float,
+    cy: float,
+    ctheta: float,
+    ex: float,
+    ey: float,
     draws: np.ndarray,
     drawn: np.ndarray,
     detected: np.ndarray,
     detection: np.ndarray,
-    game: int,
+    pair: int,
 ) -> bool:
-    """The oracle detector's capture for ``game``'s current poses (state.poses) into
-    ``detected`` and ``detection`` (rows of the game; ``frame``, ``blocked``, ``values``:
-    world.frame, world.blocked, world.sight_values; ``camera``: rules.camera,
-    ``perception``: rules.perception, ``radius``: the evader's; a range or occlusion miss
-    takes the next of the game's ``draws``, counted in ``drawn``). Returns whether the
-    evader's centre is in view. (The functions here take the world's arrays, not the
-    World: an inlined function given a NamedTuple pays a reference count per array.)"""
-    cx, cy, ctheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
-    ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
+    """The oracle detector's capture of the evader at (ex, ey) by the camera at (cx, cy,
+    ctheta) (m, rad; map frame) into ``detected`` and ``detection`` (rows ``pair``, the
+    detector pair's; ``frame``, ``blocked``, ``values``: world.frame, world.blocked,
+    world.sight_values; ``camera``: rules.camera, ``perception``: rules.perception,
+    ``radius``: the evader's; a range or occlusion miss takes the next of the pair's
+    ``draws``, counted in ``drawn``). Returns whether the evader's centre is in view.
+    (The functions here take the world's arrays, not the World: an inlined function
+    given a NamedTuple pays a reference count per array.)"""
     near, far, fov = camera[NEAR], camera[FAR], camera[FOV]
-    detected[game] = False
+    detected[pair] = False
     if not point_in_view(frame, blocked, values, near, far, fov, cx, cy, ctheta, ex, ey):
         return False
     distance = hypot(ex - cx, ey - cy)
@@ -108,89 +109,89 @@ def detect(
             perception[MISS_AT_RANGE],
             perception[OCCLUSION_MISS],
         )
-        draw = draws[game, drawn[game]]
-        drawn[game] += 1
+        draw = draws[pair, drawn[pair]]
+        drawn[pair] += 1
         if draw < chance:
             return True
-    out, g = detection, game
+    out, q = detection, pair
     box_x, box_y, box_w, box_h, depth, seen_x, seen_y = image(
         camera, cx, cy, ctheta, ex, ey, distance, 0.0, 0.0, radius
     )
-    out[g, BOX_X], out[g, BOX_Y], out[g, BOX_W], out[g, BOX_H] = box_x, box_y, box_w, box_h
-    out[g, DEPTH], out[g, SEEN_X], out[g, SEEN_Y] = depth, seen_x, seen_y
-    detected[game] = True
+    out[q, BOX_X], out[q, BOX_Y], out[q, BOX_W], out[q, BOX_H] = box_x, box_y, box_w, box_h
+    out[q, DEPTH], out[q, SEEN_X], out[q, SEEN_Y] = depth, seen_x, seen_y
+    detected[pair] = True
     return True
 
 
 @njit(cache=True, inline="always")
 def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
-    """The loop's ``_sense`` for ``game`` (detection, then ground truth in_view) and the
-    pursuer observation's memory of the last detection (``PursuerFeatures.remember``).
-    When the perception pipeline runs, a frame is captured only when one is due (into
-    state.capture), put in flight, and the result delivered by then goes into
-    state.detected and state.detection (the held one stays when none is); else the
-    capture is the detection. The caller inlines it once per game, so that the
-    NamedTuples' arrays are taken out once (and :func:`detect` is inlined once)."""
+    """The loop's ``_sense`` for ``game``: per detector pair (pursuer i, evader j) in
+    order, the detection, then ground truth in_view; then each pursuer observation's
+    memory of the last detection of its target evader i mod E
+    (``PursuerFeatures.remember``). When the perception pipeline runs, a pair's frame is
+    captured only when one is due (into state.capture), put in flight, and the result
+    delivered by then goes into state.detected and state.detection (the held one stays
+    when none is); else the capture is the detection. The caller inlines it once per
+    game, so that the NamedTuples' arrays are taken out once (and :func:`detect` is
+    inlined once)."""
     frame, blocked, values = world.frame, world.blocked, world.sight_values
-    camera, perception, radius = rules.camera, rules.perception, rules.bodies[EVADER, RADIUS]
+    n_p, n_e = rules.pursuers, rules.evaders
+    camera, perception, radius = rules.camera, rules.perception, rules.bodies[n_p, RADIUS]
     poses, detected, detection = state.poses, state.detected, state.detection
     time = state.steps[game] * rules.control_dt
     pipeline = perception[PIPELINE] != 0.0
     period, rated = perception[PERIOD], perception[RATED] != 0.0
-    due = True
-    if pipeline:
-        due, _ = frame_due(state.pipeline, game, time, period, rated)
-    px, py, ptheta = poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2]
-    ex, ey = poses[game, EVADER, 0], poses[game, EVADER, 1]
-    if due:
-        out, rows = (state.captured, state.capture) if pipeline else (detected, detection)
-        centre = detect(
-            frame,
-            blocked,
-            values,
-            camera,
-            perception,
-            radius,
-            poses,
-            state.draws,
-            state.drawn,
-            out,
-            rows,
-            game,
-        )
-    else:
-        centre = point_in_view(
-            frame, blocked, values, camera[NEAR], camera[FAR], camera[FOV], px, py, ptheta, ex, ey
-        )
-    if pipeline:
-        latency = perception[LATENCY]
-        slot_in, slot_out, _ = deliver_frame(
-            state.pipeline, game, time, period, rated, latency, due
-        )
-        if slot_in >= 0:
-            state.in_flight_detected[game, slot_in] = state.captured[game]
-            state.in_flight[game, slot_in, :] = state.capture[game, :]
-        if slot_out >= 0:
-            detected[game] = state.in_flight_detected[game, slot_out]
-            detection[game, :] = state.in_flight[game, slot_out, :]
-    state.in_view[game] = centre or silhouette_in_view(
-        frame,
-        blocked,
-        values,
-        camera[NEAR],
-        camera[FAR],
-        camera[FOV],
-        px,
-        py,
-        ptheta,
-        ex,
-        ey,
-        radius,
-        1,
-    )
-    if detected[game]:
-        seen = state.seen
-        seen[game, 0] = time
-        seen[game, 1] = detection[game, SEEN_X]
-        seen[game, 2] = detection[game, SEEN_Y]
-        state.has_seen[game] = True
+    near, far, fov = camera[NEAR], camera[FAR], camera[FOV]
+    for i in range(n_p):
+        px, py, ptheta = poses[game, i, 0], poses[game, i, 1], poses[game, i, 2]
+        for j in range(n_e):
+            q = (game * n_p + i) * n_e + j
+            ex, ey = poses[game, n_p + j, 0], poses[game, n_p + j, 1]
+            due = True
+            if pipeline:
+                due, _ = frame_due(state.pipeline, q, time, period, rated)
+            if due:
+                out, rows = (state.captured, state.capture) if pipeline else (detected, detection)
+                centre = detect(
+                    frame,
+                    blocked,
+                    values,
+                    camera,
+                    perception,
+                    radius,
+                    px,
+                    py,
+                    ptheta,
+                    ex,
+                    ey,
+                    state.draws,
+                    state.drawn,
+                    out,
+                    rows,
+                    q,
+                )
+            else:
+                centre = point_in_view(
+                    frame, blocked, values, near, far, fov, px, py, ptheta, ex, ey
+                )
+            if pipeline:
+                latency = perception[LATENCY]
+                slot_in, slot_out, _ = deliver_frame(
+                    state.pipeline, q, time, period, rated, latency, due
+                )
+                if slot_in >= 0:
+                    state.in_flight_detected[q, slot_in] = state.captured[q]
+                    state.in_flight[q, slot_in, :] = state.capture[q, :]
+                if slot_out >= 0:
+                    detected[q] = state.in_flight_detected[q, slot_out]
+                    detection[q, :] = state.in_flight[q, slot_out, :]
+            state.in_view[q] = centre or silhouette_in_view(
+                frame, blocked, values, near, far, fov, px, py, ptheta, ex, ey, radius, 1
+            )
+        target = (game * n_p + i) * n_e + i % n_e
+        if detected[target]:
+            seen, member = state.seen, game * n_p + i
+            seen[member, 0] = time
+            seen[member, 1] = detection[target, SEEN_X]
+            seen[member, 2] = detection[target, SEEN_Y]
+            state.has_seen[member] = True

@@ -8,12 +8,14 @@ the crop). Parallel over games from PARALLEL_GAMES games on.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, prange
 
 from pegame.observe.crop import CropLattice, CropScratch
 from pegame.observe.features import crop_row, evader_row, pursuer_row
-from pegame.vector.state import EVADER, FAR, PARALLEL_GAMES, PURSUER, BatchState, Rules, World
+from pegame.vector.state import FAR, PARALLEL_GAMES, PURSUER, BatchState, Rules, World
 
 
 @njit(cache=True)
@@ -45,46 +47,67 @@ _BLOCK = 64
 
 @njit(cache=True)
 def _features_block(
-    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool, block: int
+    world: World,
+    rules: Rules,
+    state: BatchState,
+    out: np.ndarray,
+    pursuer: bool,
+    member: int,
+    block: int,
 ) -> None:
-    """The rows of the games of ``block``: the arrays are taken out of the NamedTuples
-    once per block, not per game."""
+    """The rows of the games of ``block`` for pursuer (evader) ``member``: the arrays are
+    taken out of the NamedTuples once per block, not per game. Pursuer i's detection is
+    of its target evader i mod E; evader j's pursuer is the one nearest it (the loop's
+    ``nearest``: by squared distance, the lowest among ties)."""
     crop = _crop(world, np.empty(world.crop_x.size, np.int32))
     extent = world.extent
     poses, detected, has_seen = state.poses, state.detected, state.has_seen
     seen, steps = state.seen, state.steps
     far, dt = rules.camera[FAR], rules.control_dt
-    role, at = (PURSUER, 8) if pursuer else (EVADER, 12)
+    n_p, n_e = rules.pursuers, rules.evaders
+    agent, at = (member, 8) if pursuer else (n_p + member, 12)
     for game in range(block * _BLOCK, min(out.shape[0], (block + 1) * _BLOCK)):
         row = out[game]
-        own = (poses[game, role, 0], poses[game, role, 1], poses[game, role, 2])
+        own = (poses[game, agent, 0], poses[game, agent, 1], poses[game, agent, 2])
         if pursuer:
-            last = (seen[game, 0], seen[game, 1], seen[game, 2])
+            mine = game * n_p + member
+            last = (seen[mine, 0], seen[mine, 1], seen[mine, 2])
             time = steps[game] * dt
-            pursuer_row(extent, own, detected[game], has_seen[game], last, time, far, row)
+            now = detected[mine * n_e + member % n_e]
+            pursuer_row(extent, own, now, has_seen[mine], last, time, far, row)
         else:
-            chaser = (poses[game, PURSUER, 0], poses[game, PURSUER, 1], poses[game, PURSUER, 2])
+            near, best = 0, math.inf
+            if n_p > 1:
+                for i in range(n_p):
+                    dx, dy = poses[game, i, 0] - own[0], poses[game, i, 1] - own[1]
+                    d = dx**2 + dy**2
+                    if d < best:
+                        near, best = i, d
+            chaser = (poses[game, near, 0], poses[game, near, 1], poses[game, near, 2])
             evader_row(extent, own, chaser, row)
         crop_row(crop, own, row, at)
 
 
 @njit(cache=True)
 def _features_serial(
-    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool
+    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool, member: int
 ) -> None:
     for block in range(-(-out.shape[0] // _BLOCK)):
-        _features_block(world, rules, state, out, pursuer, block)
+        _features_block(world, rules, state, out, pursuer, member, block)
 
 
 @njit(cache=True, parallel=True)
 def _features_parallel(
-    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool
+    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool, member: int
 ) -> None:
     for block in prange(-(-out.shape[0] // _BLOCK)):
-        _features_block(world, rules, state, out, pursuer, block)
+        _features_block(world, rules, state, out, pursuer, member, block)
 
 
-def features(world: World, rules: Rules, state: BatchState, out: np.ndarray, role: int) -> None:
-    """The observation of ``role`` (PURSUER or EVADER) in every game into out (N, size)."""
+def features(
+    world: World, rules: Rules, state: BatchState, out: np.ndarray, role: int, member: int = 0
+) -> None:
+    """The observation of member ``member`` of ``role`` (PURSUER or EVADER) in every game
+    into out (N, size)."""
     kernel = _features_parallel if out.shape[0] >= PARALLEL_GAMES else _features_serial
-    kernel(world, rules, state, out, role == PURSUER)
+    kernel(world, rules, state, out, role == PURSUER, member)

@@ -44,8 +44,12 @@ range and range and occlusion misses (every setting of ``+experiment=paper_condi
 but its turn order; the pipeline and the miss chance are the scalar detector's own
 kernels, :mod:`pegame.detectors.perception`), not its independent or bursty misses,
 noise, false positives or detection profile; ``game.turn_order=simultaneous``; no belief in the
-observation. A pursuer strategy as the opponent adds the loop's estimation per game
-in Python (:class:`pegame.vector.opponents.PursuerStrategyOpponent`).
+observation; teams (``team.pursuers``, ``team.evaders``) when both roles learn, as the
+PettingZoo env plays them: every member moves (the pursuers, then the evaders), every
+detector pair (i, j) detects with its own miss stream and pipeline, and the measures are
+``TeamMetrics``' (coverage None, as in an env game, which builds no regions). A pursuer strategy as the
+opponent adds the loop's estimation per game in Python
+(:class:`pegame.vector.opponents.PursuerStrategyOpponent`).
 """
 
 from __future__ import annotations
@@ -68,7 +72,7 @@ from pegame.detectors.perception import (
     runs_pipeline,
 )
 from pegame.errors import ConfigError
-from pegame.game import STREAMS, Scenario, spawn
+from pegame.game import STREAMS, Scenario, member_stream, spawn_team
 from pegame.grid import OccupancyGrid
 from pegame.navigation import shared_inflation
 from pegame.observe.crop import LocalCrop
@@ -78,7 +82,7 @@ from pegame.observe.settings import EnvSettings
 from pegame.sims.grid import GridSimulator, body_rows
 from pegame.vector import kernels
 from pegame.vector.features import features
-from pegame.vector.metrics import new_tally, summary
+from pegame.vector.metrics import new_tally, summary, team_summary
 from pegame.vector.opponents import opponent_for
 from pegame.vector.state import (
     DETECTED,
@@ -104,10 +108,10 @@ PERCEPTION_OFF = {
 }
 
 
-def check_playable(scenario: Scenario, settings: EnvSettings) -> None:
-    """ConfigError naming every key whose value the batched game does not play, each with
-    the values it plays (one paragraph: a config such as ``+experiment=paper_conditions``
-    that sets several learns them all at once)."""
+def check_playable(scenario: Scenario, settings: EnvSettings, roles: Sequence[str]) -> None:
+    """ConfigError naming every key whose value the batched game of the learners
+    ``roles`` does not play, each with the values it plays (one paragraph: a config
+    such as ``+experiment=paper_conditions`` that sets several learns them all at once)."""
     refused: list[tuple[str, object, str]] = []
     if scenario.classes["sim"] is not GridSimulator:
         refused.append(("sim", scenario.names["sim"], "grid"))
@@ -118,11 +122,10 @@ def check_playable(scenario: Scenario, settings: EnvSettings) -> None:
             value = getattr(scenario.configs["detector"], key)
             if value != off:
                 refused.append((f"detector.{key}", value, repr(off)))
-    for key, size in zip(("team.pursuers", "team.evaders"), scenario.team_size):
-        if size != 1:
-            refused.append(
-                (key, size, "1 (a team game is the PettingZoo env's, pegame.envs.parallel)")
-            )
+    if scenario.team_size != (1, 1) and len(roles) != 2:
+        for key, size in zip(("team.pursuers", "team.evaders"), scenario.team_size):
+            if size != 1:
+                refused.append((key, size, "1 against an opponent (a team plays in self-play)"))
     if scenario.settings.turn_order != "simultaneous":
         allowed = "'simultaneous' (a learner commands before it sees the other's move)"
         refused.append(("game.turn_order", scenario.settings.turn_order, allowed))
@@ -158,7 +161,15 @@ class BatchedGame:
         self.roles = tuple(roles)
         self.num_games = int(num_games)
         self.scenario = scenario = Scenario(cfg)
-        check_playable(scenario, settings)
+        check_playable(scenario, settings, roles)
+        self.team_size = scenario.team_size
+        solo = self.team_size == (1, 1)
+        #: the learning agents per role, in member order (as :class:`pegame.envs.core.EnvGame`'s)
+        self.members = {
+            role: [role] if solo else [f"{role}_{k}" for k in range(size)]
+            for role, size in zip(("pursuer", "evader"), self.team_size)
+            if role in self.roles
+        }
         self._misses = misses_by_range_or_occlusion(_detector(scenario))
         context = scenario.context
         self.context = context
@@ -170,7 +181,10 @@ class BatchedGame:
         self.world = _world(context.grid, context, settings)
         self.rules = _rules(scenario)
         self.state: BatchState = new_state(
-            self.num_games, _slots(scenario), _draws(scenario) if self._misses else 1
+            self.num_games,
+            _slots(scenario),
+            _draws(scenario) if self._misses else 1,
+            *self.team_size,
         )
         self.state.tally[:] = new_tally()
         self.opponent = (
@@ -196,25 +210,34 @@ class BatchedGame:
         state, context = self.state, self.context
         games = np.asarray(games, dtype=np.int64)
         opponent = self.opponent
+        n_p, n_e = self.team_size
+        pairs = n_p * n_e
         for game, seed in zip(games.tolist(), seeds):
             streams = dict(zip(STREAMS, np.random.SeedSequence(seed).spawn(len(STREAMS))))
-            pursuer, evader = spawn(context, np.random.default_rng(streams["spawn"]))
+            pursuers, evaders = spawn_team(
+                context, np.random.default_rng(streams["spawn"]), n_p, n_e
+            )
             self.seeds[game] = seed
-            state.poses[game, PURSUER] = (pursuer.x, pursuer.y, pursuer.theta)
-            state.poses[game, EVADER] = (evader.x, evader.y, evader.theta)
+            state.poses[game] = [(pose.x, pose.y, pose.theta) for pose in (*pursuers, *evaders)]
             if opponent is not None:
-                opponent.reset(game, streams, pursuer if opponent.role == PURSUER else evader)
-            if self._misses:  # the detector's 'range' part, drawn ahead
-                rng = part_generators(np.random.default_rng(streams["detector"]))["range"]
-                state.draws[game] = rng.random(state.draws.shape[1])
+                first = pursuers[0] if opponent.role == PURSUER else evaders[0]
+                opponent.reset(game, streams, first)
+            if self._misses:  # each detector pair's 'range' part, drawn ahead
+                for q, seeded in enumerate(_detector_streams(seed, streams, n_p, n_e)):
+                    rng = part_generators(np.random.default_rng(seeded))["range"]
+                    state.draws[game * pairs + q] = rng.random(state.draws.shape[1])
+        rows = {k: (games[:, None] * k + np.arange(k)).ravel() for k in (n_p, n_e, pairs)}
         state.velocities[games] = 0.0
         state.commands[games] = 0.0
         state.steps[games] = 0
-        state.has_seen[games] = False
-        state.tally[games] = new_tally()
-        state.detected[games] = False  # nothing delivered yet
-        reset_pipeline(state.pipeline, games)
-        state.drawn[games] = 0
+        state.has_seen[rows[n_p]] = False
+        state.tally[rows[n_e]] = new_tally()
+        state.crew[rows[n_p]] = 0.0
+        state.trackers[rows[n_e]] = -1
+        state.handoffs[games] = 0.0
+        state.detected[rows[pairs]] = False  # nothing delivered yet
+        reset_pipeline(state.pipeline, rows[pairs])
+        state.drawn[rows[pairs]] = 0
         kernels.sense_games(self.world, self.rules, state, games)
         if opponent is not None:
             opponent.sensed(state, games, self.context.control_dt)
@@ -222,13 +245,16 @@ class BatchedGame:
     def step(self, playing: np.ndarray, commands: dict[str, np.ndarray]) -> np.ndarray:
         """One env step (``ticks_per_action`` control ticks) of the games where ``playing``
         (bool (N,)) is set, with the learners' ``commands`` (role -> (N, 2) (v, w) in m/s
-        and rad/s, rows of other games ignored). Returns the rewards (N,): the pursuer's
-        detections counted at the ticks reached (0 for games not playing)."""
+        and rad/s, or (N, members, 2) in a team game; rows of other games ignored).
+        Returns the detections counted at the ticks reached, (N,) in a 1v1 game and
+        (N, E) per evader in a team game (0 for games not playing)."""
         state, rules = self.state, self.rules
         state.rewards[:] = 0.0
+        n_p = rules.pursuers
         for role, command in commands.items():
-            index = PURSUER if role == "pursuer" else EVADER
-            np.copyto(state.commands[:, index], command, where=playing[:, None])
+            agents = slice(0, n_p) if role == "pursuer" else slice(n_p, None)
+            shaped = np.reshape(command, state.commands[:, agents].shape)
+            np.copyto(state.commands[:, agents], shaped, where=playing[:, None, None])
         opponent = self.opponent
         if opponent is None or opponent.table is not None:
             table = _NO_TABLE if opponent is None else opponent.table
@@ -244,12 +270,15 @@ class BatchedGame:
                 )
                 kernels.play(self.world, rules, state, live, 1, _NO_TABLE, -1)
                 opponent.sensed(state, games, rules.control_dt)
-        return state.rewards.copy()
+        rewards = state.rewards.reshape(self.num_games, rules.evaders)
+        return rewards[:, 0].copy() if self.team_size == (1, 1) else rewards.copy()
 
-    def observations(self, role: str) -> np.ndarray:
-        """Float32 (N, size): ``role``'s observation in every game (a new array)."""
+    def observations(self, role: str, member: int = 0) -> np.ndarray:
+        """Float32 (N, size): the observation of member ``member`` of ``role`` in every
+        game (a new array)."""
         out = np.empty((self.num_games, self.features[role].size), dtype=np.float32)
-        features(self.world, self.rules, self.state, out, PURSUER if role == "pursuer" else EVADER)
+        index = PURSUER if role == "pursuer" else EVADER
+        features(self.world, self.rules, self.state, out, index, member)
         return out
 
     def time(self) -> np.ndarray:
@@ -257,19 +286,29 @@ class BatchedGame:
         return self.state.steps * self.context.control_dt
 
     def tracking_rate(self) -> np.ndarray:
-        """Float64 (N,): the fraction of the ticks played with the evader detected."""
-        tally = self.state.tally
-        ticks = tally[:, TICKS]
-        return np.divide(tally[:, DETECTED], ticks, out=np.zeros(self.num_games), where=ticks > 0)
+        """Float64 (N,): the fraction of the ticks played with the evader detected (in a
+        team game its mean over the evaders, ``TeamMetrics.tracking_rate``)."""
+        tally = self.state.tally.reshape(self.num_games, self.rules.evaders, -1)
+        ticks = tally[:, :, TICKS]
+        rates = np.divide(tally[:, :, DETECTED], ticks, out=np.zeros(ticks.shape), where=ticks > 0)
+        return rates[:, 0] if self.team_size == (1, 1) else rates.mean(axis=1)
 
     def summary(self, game: int) -> dict:
-        """Game ``game``'s measures (``TrackingMetrics.summary``): a pursuer strategy's
-        opponent keeps them itself (with the estimator's), else the kernels' tally. The
-        batched game keeps no loss causes (:mod:`pegame.losses`): ``loss_causes`` is None."""
+        """Game ``game``'s measures (``TrackingMetrics.summary``, or ``TeamMetrics``'s in a
+        team game): a pursuer strategy's opponent keeps them itself (with the
+        estimator's), else the kernels' tally. The batched game keeps no loss causes
+        (:mod:`pegame.losses`): ``loss_causes`` is None."""
         metrics = getattr(self.opponent, "metrics", None)
         if metrics is not None:
             return {**metrics[game].summary(), "loss_causes": None}
-        return {**summary(self.state.tally[game], self.context.control_dt), "loss_causes": None}
+        dt, (n_p, n_e) = self.context.control_dt, self.team_size
+        state = self.state
+        if (n_p, n_e) == (1, 1):
+            return {**summary(state.tally[game], dt), "loss_causes": None}
+        rows = state.tally[game * n_e : (game + 1) * n_e]
+        crew = state.crew[game * n_p : (game + 1) * n_p]
+        handoffs = int(state.handoffs[game])
+        return {**team_summary(rows, crew, handoffs, dt), "loss_causes": None}
 
 
 _NO_TABLE = np.zeros((1, 1, 2))
@@ -340,7 +379,8 @@ def _rules(scenario: Scenario) -> Rules:
     context, settings = scenario.context, scenario.settings
     detector = scenario.configs["detector"]
     assert isinstance(detector, OracleDetector.Config)  # check_playable: the oracle's
-    bodies = body_rows(context.pursuer, context.evader)
+    n_p, n_e = scenario.team_size
+    bodies = body_rows(*[context.pursuer] * n_p, *[context.evader] * n_e)
     return Rules(
         bodies,
         camera_numbers(context.camera, detector),
@@ -349,4 +389,19 @@ def _rules(scenario: Scenario) -> Rules:
         int(settings.substeps),
         int(settings.decide_every),
         int(settings.ticks),
+        int(n_p),
+        int(n_e),
     )
+
+
+def _detector_streams(
+    seed: int, streams: dict, pursuers: int, evaders: int
+) -> list[np.random.SeedSequence]:
+    """The seed sequence of each detector pair's generator in pair order (the one
+    :class:`pegame.game.Game` builds it with: pair (0, 0) the 1v1 detector's stream, the
+    others a team member's, ``Game._member``)."""
+    return [
+        streams["detector"] if (i, j) == (0, 0) else member_stream(seed, "detector", i, j)
+        for i in range(pursuers)
+        for j in range(evaders)
+    ]

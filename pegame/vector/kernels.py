@@ -27,9 +27,14 @@ import numba
 import numpy as np
 from numba import njit, prange
 
+from pegame.numerics import hypot
 from pegame.sims.grid import move
 from pegame.vector.camera import sense
 from pegame.vector.state import (
+    CREW_DETECTED,
+    CREW_LAST_X,
+    CREW_LAST_Y,
+    CREW_PATH,
     DETECTED,
     DISTANCE_SUM,
     EVADER,
@@ -59,17 +64,20 @@ from pegame.vector.state import (
 @njit(cache=True, inline="always")
 def tally(
     t: np.ndarray,
-    poses: np.ndarray,
-    in_view: np.ndarray,
-    detected: np.ndarray,
-    game: int,
+    row: int,
+    px: float,
+    py: float,
+    ex: float,
+    ey: float,
+    detected: bool,
+    in_view: bool,
     dt: float,
 ) -> None:
-    """``TrackingMetrics.add`` for ``game``'s current tick, as running sums (no belief),
-    into ``t`` = state.tally from the state's poses, in_view and detected."""
-    g = game
-    px, py = poses[g, PURSUER, 0], poses[g, PURSUER, 1]
-    ex, ey = poses[g, EVADER, 0], poses[g, EVADER, 1]
+    """``TrackingMetrics.add`` of one tick, as running sums (no belief), into row ``row``
+    of ``t`` (state.tally, an evader's row): the pursuer at (px, py) (m; in a team game the
+    one nearest the evader), the evader at (ex, ey), whether it was ``detected`` (by some
+    pursuer) and ``in_view`` (of some pursuer)."""
+    g = row
     tick = t[g, TICKS]
     if tick > 0:
         dx, dy = px - t[g, LAST_PX], py - t[g, LAST_PY]
@@ -79,8 +87,8 @@ def tally(
     t[g, LAST_PX], t[g, LAST_PY], t[g, LAST_EX], t[g, LAST_EY] = px, py, ex, ey
     dx, dy = px - ex, py - ey
     t[g, DISTANCE_SUM] += math.sqrt(dx * dx + dy * dy)
-    t[g, IN_VIEW] += in_view[g]
-    if detected[g]:
+    t[g, IN_VIEW] += in_view
+    if detected:
         t[g, DETECTED] += 1.0
         if t[g, IN_LOSS]:
             length = tick - t[g, LOSS_START]
@@ -96,6 +104,55 @@ def tally(
     t[g, TICKS] = tick + 1.0
 
 
+@njit(cache=True, inline="always")
+def _measure(rules: Rules, state: BatchState, game: int) -> None:
+    """The game's measures of its current tick (the loop's ``_measure``): each evader's
+    :func:`tally` with the pursuer nearest it (``TeamMetrics.add``: by distance, the
+    lowest among ties), detected and in view if some pursuer detects it (has it in
+    view); in a team game also the handoffs (``TeamMetrics._hand``: state.trackers,
+    state.handoffs) and each pursuer's detections and path (state.crew)."""
+    n_p, n_e = rules.pursuers, rules.evaders
+    solo = n_p == 1 and n_e == 1
+    poses, detected, in_view, dt = state.poses, state.detected, state.in_view, rules.control_dt
+    for j in range(n_e):
+        ex, ey = poses[game, n_p + j, 0], poses[game, n_p + j, 1]
+        near, best = 0, math.inf
+        seen, visible, first = False, False, -1
+        for i in range(n_p):
+            q = (game * n_p + i) * n_e + j
+            if detected[q] and not seen:
+                seen, first = True, i
+            visible = visible or in_view[q]
+            if n_p > 1:
+                d = hypot(ex - poses[game, i, 0], ey - poses[game, i, 1])
+                if d < best:
+                    near, best = i, d
+        px, py = poses[game, near, 0], poses[game, near, 1]
+        tally(state.tally, game * n_e + j, px, py, ex, ey, seen, visible, dt)
+        if not solo:
+            trackers, row = state.trackers, game * n_e + j
+            tracker = trackers[row]
+            if not seen:
+                trackers[row] = -1
+            elif tracker < 0 or not detected[(game * n_p + tracker) * n_e + j]:
+                trackers[row] = first
+                state.handoffs[game] += tracker >= 0
+    if solo:
+        return
+    crew = state.crew
+    for i in range(n_p):
+        member = game * n_p + i
+        x, y = poses[game, i, 0], poses[game, i, 1]
+        if state.steps[game] > 0:
+            dx, dy = x - crew[member, CREW_LAST_X], y - crew[member, CREW_LAST_Y]
+            crew[member, CREW_PATH] += math.sqrt(dx * dx + dy * dy)
+        crew[member, CREW_LAST_X], crew[member, CREW_LAST_Y] = x, y
+        for j in range(n_e):
+            if detected[(game * n_p + i) * n_e + j]:
+                crew[member, CREW_DETECTED] += 1.0
+                break
+
+
 @njit(cache=True)
 def _play_game(
     world: World,
@@ -109,12 +166,14 @@ def _play_game(
 ) -> None:
     """Up to ``ticks`` control ticks of ``game`` in the loop's order (see
     :mod:`pegame.vector.game`): the scripted command, the measures, the simulator's
-    substeps, the next tick sensed. The arrays are taken out of the NamedTuples once."""
+    substeps (the pursuers, then the evaders, in member order), the next tick sensed,
+    each evader's detections counted. The arrays are taken out of the NamedTuples once."""
     if not playing[game]:
         return
     masks, frame, bodies = world.masks, world.frame, rules.bodies
     poses, velocities, commands, steps = state.poses, state.velocities, state.commands, state.steps
     dt = rules.control_dt / rules.substeps
+    n_p, n_e = rules.pursuers, rules.evaders
     for _ in range(ticks):
         if steps[game] >= rules.ticks:
             break
@@ -122,15 +181,19 @@ def _play_game(
             decision = steps[game] // rules.decide_every
             commands[game, table_role, 0] = table[game, decision, 0]
             commands[game, table_role, 1] = table[game, decision, 1]
-        tally(state.tally, poses, state.in_view, state.detected, game, rules.control_dt)
+        _measure(rules, state, game)
         for _ in range(rules.substeps):
-            v, w = commands[game, PURSUER, 0], commands[game, PURSUER, 1]
-            move(masks[PURSUER], frame, bodies, poses, velocities, game, PURSUER, v, w, dt)
-            v, w = commands[game, EVADER, 0], commands[game, EVADER, 1]
-            move(masks[EVADER], frame, bodies, poses, velocities, game, EVADER, v, w, dt)
+            for agent in range(n_p + n_e):
+                mask = masks[PURSUER] if agent < n_p else masks[EVADER]
+                v, w = commands[game, agent, 0], commands[game, agent, 1]
+                move(mask, frame, bodies, poses, velocities, game, agent, v, w, dt)
         steps[game] += 1
         sense(world, rules, state, game)
-        state.rewards[game] += state.detected[game]
+        for j in range(n_e):
+            for i in range(n_p):
+                if state.detected[(game * n_p + i) * n_e + j]:
+                    state.rewards[game * n_e + j] += 1.0
+                    break
 
 
 @njit(cache=True, parallel=True)

@@ -6,13 +6,15 @@ Counts, rates, the first loss, the longest loss and the reacquisition maximum ar
 means and path lengths are sums taken tick by tick where numpy sums pairwise, which can
 differ in the last bits before the 6-decimal rounding of the result. No estimator runs in
 a batched game: its measures (estimation error, n_eff, resamplings) are None and 0, as
-in a single env game without an estimate.
+in a single env game without an estimate. A team game's are each evader's, combined as
+:func:`pegame.metrics.team_summary` combines them for the single game.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from pegame import metrics
 from pegame.metrics import _rounded
 from pegame.vector import state as k
 
@@ -51,3 +53,21 @@ def summary(row: np.ndarray, dt: float) -> dict[str, float | int | None]:
         "n_eff_min": None,
         "resamplings": 0,
     }
+
+
+def team_summary(rows: np.ndarray, crew: np.ndarray, handoffs: int, dt: float) -> dict:
+    """``TeamMetrics.summary`` (without loss causes) of a team game whose evaders' tally
+    rows are ``rows`` (E, TALLY_SIZE) and pursuers' rows of state.crew ``crew`` (P,
+    CREW_SIZE), with ``handoffs``; coverage None (it needs the pursuers' regions, which neither the
+    batched game nor an env game builds)."""
+    ticks = rows[:, k.TICKS]
+    rates = np.divide(rows[:, k.DETECTED], ticks, out=np.zeros(ticks.size), where=ticks > 0)
+    return metrics.team_summary(
+        [summary(row, dt) for row in rows],
+        rates.tolist(),
+        crew[:, k.CREW_PATH].tolist(),
+        [int(n) for n in crew[:, k.CREW_DETECTED]],
+        int(ticks[0]),
+        handoffs,
+        [],
+    )

@@ -29,7 +29,8 @@ from pegame.sims.grid import RADIUS as RADIUS
 from pegame.sims.grid import V_MAX as V_MAX
 from pegame.sims.grid import W_MAX as W_MAX
 
-#: the roles' index in the role axes
+#: the roles' index in the role axes (World.masks), and a 1v1 game's agents' in the agent
+#: axes (a team's agents are its pursuers, then its evaders)
 PURSUER, EVADER = 0, 1
 #: entries of ``rules.perception`` (the perception model's parts the batched game plays,
 #: :mod:`pegame.detectors.perception`): the capture period (s), whether a rate sets it,
@@ -61,6 +62,11 @@ DETECTION_SIZE = 7
     LAST_EY,
 ) = range(17)
 TALLY_SIZE = 17
+#: columns of ``state.crew``, a team game's per-pursuer measures
+#: (:class:`pegame.metrics.TeamMetrics`): ticks it detected some evader, its path (m), its
+#: last position (m)
+CREW_DETECTED, CREW_PATH, CREW_LAST_X, CREW_LAST_Y = range(4)
+CREW_SIZE = 4
 
 #: batches of at least this many games are spread over numba's threads (prange); below,
 #: starting the threads costs more than it saves, most of all on a busy machine
@@ -101,11 +107,12 @@ class World(NamedTuple):
 class Rules(NamedTuple):
     """The game's fixed numbers.
 
-    bodies: (2, 5) float64 per role (pursuer, evader): radius (m), v_max (m/s), w_max
-    (rad/s), a_max (m/s^2), alpha_max (rad/s^2); camera: float64 (9,) as the constants
+    bodies: (A, 5) float64 per agent (the pursuers, then the evaders): radius (m), v_max
+    (m/s), w_max (rad/s), a_max (m/s^2), alpha_max (rad/s^2); camera: float64 (9,) as the constants
     FOV..CAMERA_HEIGHT (:func:`pegame.detectors.oracle.camera_numbers`); perception:
     float64 (8,) as the constants PERIOD..OCCLUSION_MISS; control_dt (s); substeps per
-    control tick; decide_every: control ticks per decision; ticks: control ticks per game.
+    control tick; decide_every: control ticks per decision; ticks: control ticks per game;
+    pursuers, evaders: the team sizes P and E (1 and 1 in a 1v1 game).
     """
 
     bodies: np.ndarray
@@ -115,24 +122,33 @@ class Rules(NamedTuple):
     substeps: int
     decide_every: int
     ticks: int
+    pursuers: int
+    evaders: int
 
 
 class BatchState(NamedTuple):
-    """The games' state, first axis the game.
+    """The games' state. A game has A = P + E agents, its pursuers then its evaders, and
+    Q = P * E detector pairs (pursuer i, evader j); per-game arrays have the game as first
+    axis, per-member and per-pair ones a row per member or pair of each game in order
+    (row ``game * E + j`` of evader j, ``game * P + i`` of pursuer i, ``game * Q + i * E +
+    j`` of pair (i, j)), so that a 1v1 game's rows are the game's.
 
-    poses (N, 2, 3): (x, y, theta) per role; velocities (N, 2, 2): the current (v, w) of
-    bodies with acceleration limits; commands (N, 2, 2): this tick's (v, w) commands;
-    steps (N,): control ticks played; detected (N,): the current tick's detection;
-    detection (N, 7): its box, depth and position (columns BOX_X..SEEN_Y); in_view (N,);
-    seen (N, 3): time (s) and position of the last detection, for the pursuer's
-    observation, with has_seen (N,); tally (N, TALLY_SIZE): the metrics' running sums;
-    rewards (N,): detections counted in the current env step.
+    Per game: poses (N, A, 3): (x, y, theta) per agent; velocities (N, A, 2): the current
+    (v, w) of bodies with acceleration limits; commands (N, A, 2): this tick's (v, w)
+    commands; steps (N,): control ticks played; handoffs (N,): a team game's handoffs.
+    Per pair: detected: the current tick's detection; detection (., 7): its box, depth and
+    position (columns BOX_X..SEEN_Y); in_view. Per pursuer: seen (., 3): time (s) and
+    position of the last detection of its target evader (i mod E), for its observation,
+    with has_seen; crew (., CREW_SIZE): a team game's per-pursuer measures. Per evader:
+    tally (., TALLY_SIZE): the metrics' running sums (the pursuer nearest it as the
+    pursuer); trackers: the pursuer tracking it, -1 none (a team game's handoffs);
+    rewards: the ticks it was detected by some pursuer in the current env step.
 
-    The perception pipeline, when it runs (delivered: detected and detection): pipeline
-    (N, DUE + K): each game's (:func:`pegame.detectors.perception.new_pipeline`); captured
-    (N,) and capture (N, 7): the tick's own capture; in_flight_detected (N, K) and
-    in_flight (N, K, 7): the results in flight by slot; draws (N, D): each game's range
-    stream drawn ahead (the range and occlusion misses), drawn (N,) of them used.
+    The perception pipeline, per pair, when it runs (delivered: detected and detection):
+    pipeline (., DUE + K): each pair's (:func:`pegame.detectors.perception.new_pipeline`);
+    captured and capture (., 7): the tick's own capture; in_flight_detected (., K) and
+    in_flight (., K, 7): the results in flight by slot; draws (., D): each pair's range
+    stream drawn ahead (the range and occlusion misses), drawn of them used.
     """
 
     poses: np.ndarray
@@ -153,29 +169,38 @@ class BatchState(NamedTuple):
     in_flight: np.ndarray
     draws: np.ndarray
     drawn: np.ndarray
+    crew: np.ndarray
+    trackers: np.ndarray
+    handoffs: np.ndarray
 
 
-def new_state(num_games: int, slots: int = 1, draws: int = 1) -> BatchState:
-    """Zeroed state for ``num_games`` games, ``slots`` results in flight and ``draws``
-    random numbers per game."""
-    n = num_games
+def new_state(
+    num_games: int, slots: int = 1, draws: int = 1, pursuers: int = 1, evaders: int = 1
+) -> BatchState:
+    """Zeroed state for ``num_games`` games of ``pursuers`` against ``evaders``, ``slots``
+    results in flight and ``draws`` random numbers per pair."""
+    n, agents, pairs = num_games, pursuers + evaders, num_games * pursuers * evaders
+    crew, members = num_games * pursuers, num_games * evaders
     return BatchState(
-        np.zeros((n, 2, 3)),
-        np.zeros((n, 2, 2)),
-        np.zeros((n, 2, 2)),
+        np.zeros((n, agents, 3)),
+        np.zeros((n, agents, 2)),
+        np.zeros((n, agents, 2)),
         np.zeros(n, np.int64),
-        np.zeros(n, np.bool_),
-        np.zeros((n, DETECTION_SIZE)),
-        np.zeros(n, np.bool_),
-        np.zeros((n, 3)),
-        np.zeros(n, np.bool_),
-        np.zeros((n, TALLY_SIZE)),
+        np.zeros(pairs, np.bool_),
+        np.zeros((pairs, DETECTION_SIZE)),
+        np.zeros(pairs, np.bool_),
+        np.zeros((crew, 3)),
+        np.zeros(crew, np.bool_),
+        np.zeros((members, TALLY_SIZE)),
+        np.zeros(members),
+        new_pipeline(pairs, slots),
+        np.zeros(pairs, np.bool_),
+        np.zeros((pairs, DETECTION_SIZE)),
+        np.zeros((pairs, slots), np.bool_),
+        np.zeros((pairs, slots, DETECTION_SIZE)),
+        np.zeros((pairs, draws)),
+        np.zeros(pairs, np.int64),
+        np.zeros((crew, CREW_SIZE)),
+        np.full(members, -1, np.int64),
         np.zeros(n),
-        new_pipeline(n, slots),
-        np.zeros(n, np.bool_),
-        np.zeros((n, DETECTION_SIZE)),
-        np.zeros((n, slots), np.bool_),
-        np.zeros((n, slots, DETECTION_SIZE)),
-        np.zeros((n, draws)),
-        np.zeros(n, np.int64),
     )

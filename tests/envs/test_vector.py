@@ -274,9 +274,95 @@ def test_bad_actions_and_unsupported_configs_are_clear_errors():
         vector_env(2, overrides=SHORT, role="referee")
 
 
-def test_a_team_is_refused_not_played_as_1v1():
-    # vector_env(..., overrides=["team.pursuers=3", "team.evaders=2"]) played 1v1 silently
+def test_a_team_is_refused_against_an_opponent_not_played_as_1v1():
+    # vector_env(..., overrides=["team.pursuers=3", "team.evaders=2"]) played 1v1 silently;
+    # the single-agent envs refuse a team too: a team plays in self-play
     with pytest.raises(ConfigError, match="'team.pursuers': 3 .*; 'team.evaders': 2 "):
         vector_env(2, overrides=["env=hall", "team.pursuers=3", "team.evaders=2"])
     with pytest.raises(ConfigError, match="'team.evaders' in a batched env: 2"):
-        vector_env(2, overrides=["env=hall", "team.evaders=2"], role="both")
+        vector_env(2, overrides=["env=hall", "team.evaders=2"], role="evader")
+
+
+def play_teams_side_by_side(overrides: list[str], n: int, seed: int, steps: int) -> int:
+    """A batched self-play env of ``n`` team games against ``n`` single PettingZoo envs
+    seeded as its games are, stepped with the same random actions: every observation,
+    reward, truncation and info the same, through an autoreset. Returns the games ended."""
+    batched = SelfPlayVectorEnv(n, overrides=overrides, decision_period=0.3)
+    singles = [parallel_env(overrides=overrides, decision_period=0.3) for _ in range(n)]
+    assert batched.possible_agents == singles[0].possible_agents
+    obs_b, _ = batched.reset(seed=seed)
+    for i, single in enumerate(singles):
+        obs_s, _ = single.reset(seed=seed + i)
+        for agent in single.possible_agents:
+            np.testing.assert_array_equal(obs_b[agent][i], obs_s[agent])
+    rng, ended = np.random.default_rng(seed), 0
+    for _ in range(steps):
+        actions = {
+            agent: rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+            for agent in batched.possible_agents
+        }
+        obs_b, rew_b, _, trunc_b, info_b = batched.step(actions)
+        for i, single in enumerate(singles):
+            if not single.agents:  # the batched game autoresets: the single env resets
+                seed_i = int(info_b["seed"][i])
+                obs_s, _ = single.reset(seed=seed_i)
+                for agent in single.possible_agents:
+                    np.testing.assert_array_equal(obs_b[agent][i], obs_s[agent])
+                continue
+            obs_s, rew_s, _, trunc_s, info_s = single.step(
+                {agent: a[i] for agent, a in actions.items()}
+            )
+            for agent in single.possible_agents:
+                np.testing.assert_array_equal(obs_b[agent][i], obs_s[agent])
+                assert rew_b[agent][i] == rew_s[agent], agent
+                assert trunc_b[agent][i] == trunc_s[agent]
+            first = single.possible_agents[0]
+            assert info_b["tracking_rate"][i] == info_s[first]["tracking_rate"]
+            if trunc_s[first]:
+                ended += 1
+                got = {k: v[i] for k, v in info_b["metrics"].items() if not k.startswith("_")}
+                assert got.pop("loss_causes") is None  # not kept by the batched game
+                want = dict(info_s[first]["metrics"])
+                want.pop("loss_causes")
+                assert got == want
+    return ended
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "team",
+    [
+        ["team.pursuers=2", "team.evaders=2"],
+        ["team.pursuers=3", "team.evaders=1"],
+        ["team.pursuers=1", "team.evaders=2", *PERCEPTION["parts"], "pursuer.a_max=0.5"],
+    ],
+)
+def test_team_self_play_plays_the_parallel_envs_team_games(team):
+    """Every member's move, each detector pair's detection (its own miss stream and
+    pipeline), the nearest pursuer, the team's rewards and TeamMetrics' measures."""
+    overrides = ["env=enclosed", "game.t_max=3", "game.physics_hz=20", *team]
+    ended = play_teams_side_by_side(overrides, n=2, seed=5, steps=14)
+    assert ended == 2  # one game each ended, and the next ones played on identically
+
+
+def test_a_team_game_hands_the_evader_over_and_sums_the_teams_reward():
+    """The measures the team game adds are counted, not left at zero: the games of a
+    two-pursuer team see handoffs, and the pursuers' reward is the sum of the evaders'."""
+    overrides = ["env=hall", "game.t_max=20", "team.pursuers=3", "team.evaders=2"]
+    env = SelfPlayVectorEnv(16, overrides=overrides)
+    env.reset(seed=3)
+    rng = np.random.default_rng(1)
+    totals = dict.fromkeys(env.possible_agents, 0.0)
+    while True:
+        actions = {a: rng.uniform(-1, 1, (16, 2)).astype(np.float32) for a in env.possible_agents}
+        _, rewards, _, trunc, infos = env.step(actions)
+        np.testing.assert_array_equal(
+            rewards["pursuer_0"], -(rewards["evader_0"] + rewards["evader_1"])
+        )
+        for agent, reward in rewards.items():
+            totals[agent] += float(reward.sum())
+        if trunc["pursuer_0"].all():
+            break
+    handoffs = infos["metrics"]["handoffs"]
+    assert totals["pursuer_0"] > 0 and sum(handoffs) > 0
+    assert all(len(rates) == 3 for rates in infos["metrics"]["tracking_rate_per_pursuer"])
