@@ -17,12 +17,13 @@ TickLoop.advance                       BatchedGame.step (per control tick)
 opponent observes; decides at a        opponent.command (the smart evader's batch kernel,
 decision tick; gives its command       or a strategy per game in Python), or the tick
                                        kernel reads the opponent's action table
-metrics.add(current tick)              kernels.tally
-_integrate: substeps, pursuer then     sims.grid.move(pursuer), sims.grid.move(evader), per
-evader (GridSimulator.step)            substep (the simulator's own kernel)
-step += 1; _sense(): poses, detector,  steps += 1; camera.sense: camera.detect, then
-in_view                                sight.silhouette_in_view
-EnvGame: reward += detection,          camera.sense (memory), state.rewards
+_measure: metrics.add (current tick)   kernels._measure: kernels.tally per evader (and the
+                                       team's handoffs and per-pursuer measures)
+_integrate: substeps, the pursuers     sims.grid.move per agent, pursuers then evaders, per
+then the evaders (GridSimulator.step)  substep (the simulator's own kernel)
+step += 1; _sense(): poses, detector   steps += 1; camera.sense: per pair camera.detect,
+per pair, in_view per pair             then sight.silhouette_in_view
+EnvGame: reward += detections,         camera.sense (memory), state.rewards per evader
 features.remember
 =====================================  =====================================================
 

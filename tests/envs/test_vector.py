@@ -335,6 +335,7 @@ def play_teams_side_by_side(overrides: list[str], n: int, seed: int, steps: int)
         ["team.pursuers=2", "team.evaders=2"],
         ["team.pursuers=3", "team.evaders=1"],
         ["team.pursuers=1", "team.evaders=2", *PERCEPTION["parts"], "pursuer.a_max=0.5"],
+        ["team.pursuers=2", "team.evaders=2", *PERCEPTION["paper"]],
     ],
 )
 def test_team_self_play_plays_the_parallel_envs_team_games(team):
