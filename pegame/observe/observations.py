@@ -155,7 +155,7 @@ class PursuerFeatures(_Features):
             self._crop_at,
         )
         if self.settings.belief:
-            self._belief(out[8:12], pose, belief)
+            self.belief_part(out[8:12], pose, belief)
         return out
 
     def update(self, observation: PursuerObservation) -> None:
@@ -167,7 +167,9 @@ class PursuerFeatures(_Features):
         self.update(observation)
         return self.build(observation.time, observation.pose, observation.belief)
 
-    def _belief(self, out: np.ndarray, pose: Pose, belief: Belief) -> None:
+    def belief_part(self, out: np.ndarray, pose: Pose, belief: Belief) -> None:
+        """The ``belief`` part (4 values, module docstring) for the pursuer at ``pose``
+        into ``out``."""
         if belief.mean is None:
             out[:] = 0.0
             return

@@ -53,10 +53,12 @@ def _features_block(
     out: np.ndarray,
     pursuer: bool,
     member: int,
+    at: int,
     block: int,
 ) -> None:
     """The rows of the games of ``block`` for pursuer (evader) ``member``: the arrays are
-    taken out of the NamedTuples once per block, not per game. Pursuer i's detection is
+    taken out of the NamedTuples once per block, not per game; the crop goes to
+    row[at:]. Pursuer i's detection is
     of its target evader i mod E; evader j's pursuer is the one nearest it (the loop's
     ``nearest``: by squared distance, the lowest among ties)."""
     crop = _crop(world, np.empty(world.crop_x.size, np.int32))
@@ -65,7 +67,7 @@ def _features_block(
     seen, steps = state.seen, state.steps
     far, dt = rules.camera[FAR], rules.control_dt
     n_p, n_e = rules.pursuers, rules.evaders
-    agent, at = (member, 8) if pursuer else (n_p + member, 12)
+    agent = member if pursuer else n_p + member
     for game in range(block * _BLOCK, min(out.shape[0], (block + 1) * _BLOCK)):
         row = out[game]
         own = (poses[game, agent, 0], poses[game, agent, 1], poses[game, agent, 2])
@@ -90,24 +92,44 @@ def _features_block(
 
 @njit(cache=True)
 def _features_serial(
-    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool, member: int
+    world: World,
+    rules: Rules,
+    state: BatchState,
+    out: np.ndarray,
+    pursuer: bool,
+    member: int,
+    at: int,
 ) -> None:
     for block in range(-(-out.shape[0] // _BLOCK)):
-        _features_block(world, rules, state, out, pursuer, member, block)
+        _features_block(world, rules, state, out, pursuer, member, at, block)
 
 
 @njit(cache=True, parallel=True)
 def _features_parallel(
-    world: World, rules: Rules, state: BatchState, out: np.ndarray, pursuer: bool, member: int
+    world: World,
+    rules: Rules,
+    state: BatchState,
+    out: np.ndarray,
+    pursuer: bool,
+    member: int,
+    at: int,
 ) -> None:
     for block in prange(-(-out.shape[0] // _BLOCK)):
-        _features_block(world, rules, state, out, pursuer, member, block)
+        _features_block(world, rules, state, out, pursuer, member, at, block)
 
 
 def features(
-    world: World, rules: Rules, state: BatchState, out: np.ndarray, role: int, member: int = 0
+    world: World,
+    rules: Rules,
+    state: BatchState,
+    out: np.ndarray,
+    role: int,
+    member: int = 0,
+    crop: int | None = None,
 ) -> None:
     """The observation of member ``member`` of ``role`` (PURSUER or EVADER) in every game
-    into out (N, size)."""
+    into out (N, size), the crop from column ``crop`` (default: right after the role's
+    features; a pursuer's belief part, which the caller fills, comes before it)."""
+    at = (8 if role == PURSUER else 12) if crop is None else crop
     kernel = _features_parallel if out.shape[0] >= PARALLEL_GAMES else _features_serial
-    kernel(world, rules, state, out, role == PURSUER, member)
+    kernel(world, rules, state, out, role == PURSUER, member, at)

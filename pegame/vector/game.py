@@ -44,12 +44,14 @@ simulator; the oracle detector with the perception model's rate, latency, detect
 range and range and occlusion misses (every setting of ``+experiment=paper_conditions``
 but its turn order; the pipeline and the miss chance are the scalar detector's own
 kernels, :mod:`pegame.detectors.perception`), not its independent or bursty misses,
-noise, false positives or detection profile; ``game.turn_order=simultaneous``; no belief in the
-observation; teams (``team.pursuers``, ``team.evaders``) when both roles learn, as the
-PettingZoo env plays them: every member moves (the pursuers, then the evaders), every
-detector pair (i, j) detects with its own miss stream and pipeline, and the measures are
-``TeamMetrics``' (coverage None, as in an env game, which builds no regions). A pursuer strategy as the
-opponent adds the loop's estimation per game in Python
+noise, false positives or detection profile; ``game.turn_order=simultaneous``; the belief
+in a 1v1 pursuer's observation (``belief=True``: the estimator runs per game in Python,
+:mod:`pegame.vector.estimation`, at a single game's cost); teams (``team.pursuers``,
+``team.evaders``) when both roles learn, as the PettingZoo env plays them: every member
+moves (the pursuers, then the evaders), every detector pair (i, j) detects with its own
+miss stream and pipeline, and the measures are ``TeamMetrics``' (coverage None, as in an
+env game, which builds no regions). A pursuer strategy as the opponent adds the loop's
+estimation per game in Python
 (:class:`pegame.vector.opponents.PursuerStrategyOpponent`).
 """
 
@@ -81,10 +83,12 @@ from pegame.observe.features import extent_numbers
 from pegame.observe.observations import EvaderFeatures, PursuerFeatures
 from pegame.observe.settings import EnvSettings
 from pegame.sims.grid import GridSimulator, body_rows
+from pegame.types import Pose
 from pegame.vector import kernels
-from pegame.vector.features import features
+from pegame.vector.estimation import Estimation
+from pegame.vector.features import features as kernel_features
 from pegame.vector.metrics import new_tally, summary, team_summary
-from pegame.vector.opponents import opponent_for
+from pegame.vector.opponents import needs_estimation, opponent_for
 from pegame.vector.state import (
     DETECTED,
     EVADER,
@@ -130,8 +134,8 @@ def check_playable(scenario: Scenario, settings: EnvSettings, roles: Sequence[st
     if scenario.settings.turn_order != "simultaneous":
         allowed = "'simultaneous' (a learner commands before it sees the other's move)"
         refused.append(("game.turn_order", scenario.settings.turn_order, allowed))
-    if settings.belief:
-        refused.append(("belief", settings.belief, "False (no estimator runs in the batched game)"))
+    if settings.belief and scenario.team_size != (1, 1):
+        refused.append(("belief", settings.belief, "False in a team game"))
     if not refused:
         return
     tail = "the batched kernels play only these; use the single env for the rest"
@@ -188,8 +192,17 @@ class BatchedGame:
             *self.team_size,
         )
         self.state.tally[:] = new_tally()
+        #: the loop's estimation per game, for a pursuer strategy or a belief observation
+        self.estimation = (
+            Estimation(scenario, self.num_games)
+            if (settings.belief and "pursuer" in self.roles)
+            or (len(self.roles) == 1 and needs_estimation(scenario, self.roles[0]))
+            else None
+        )
         self.opponent = (
-            opponent_for(scenario, self.roles[0], self.rules.bodies, self.num_games)
+            opponent_for(
+                scenario, self.roles[0], self.rules.bodies, self.num_games, self.estimation
+            )
             if len(self.roles) == 1
             else None
         )
@@ -223,6 +236,8 @@ class BatchedGame:
             if opponent is not None:
                 first = pursuers[0] if opponent.role == PURSUER else evaders[0]
                 opponent.reset(game, streams, first)
+            if self.estimation is not None:
+                self.estimation.reset(game, streams)
             if self._misses:  # each detector pair's 'range' part, drawn ahead
                 for q, seeded in enumerate(_detector_streams(seed, streams, n_p, n_e)):
                     rng = part_generators(np.random.default_rng(seeded))["range"]
@@ -240,6 +255,8 @@ class BatchedGame:
         reset_pipeline(state.pipeline, rows[pairs])
         state.drawn[rows[pairs]] = 0
         kernels.sense_games(self.world, self.rules, state, games)
+        if self.estimation is not None:
+            self.estimation.sensed(state, games)
         if opponent is not None:
             opponent.sensed(state, games, self.context.control_dt)
 
@@ -256,30 +273,45 @@ class BatchedGame:
             agents = slice(0, n_p) if role == "pursuer" else slice(n_p, None)
             shaped = np.reshape(command, state.commands[:, agents].shape)
             np.copyto(state.commands[:, agents], shaped, where=playing[:, None, None])
-        opponent = self.opponent
-        if opponent is None or opponent.table is not None:
-            table = _NO_TABLE if opponent is None else opponent.table
-            played = -1 if opponent is None else opponent.role
+        opponent, estimation = self.opponent, self.estimation
+        table = _NO_TABLE if opponent is None or opponent.table is None else opponent.table
+        played = -1 if opponent is None or opponent.table is None else opponent.role
+        if estimation is None and (opponent is None or opponent.table is not None):
             kernels.play(self.world, rules, state, playing, self.ticks_per_action, table, played)
-        else:
+        else:  # tick by tick: Python's part of a tick around the kernels'
             for _ in range(self.ticks_per_action):
                 live = playing & (state.steps < rules.ticks)
                 games = np.flatnonzero(live)
                 steps = state.steps[games]
-                opponent.command(
-                    state, games, steps * rules.control_dt, steps % rules.decide_every == 0
-                )
-                kernels.play(self.world, rules, state, live, 1, _NO_TABLE, -1)
-                opponent.sensed(state, games, rules.control_dt)
+                if opponent is not None:
+                    time, deciding = steps * rules.control_dt, steps % rules.decide_every == 0
+                    opponent.command(state, games, time, deciding)
+                if estimation is not None:
+                    estimation.measure(state, games)
+                kernels.play(self.world, rules, state, live, 1, table, played)
+                if estimation is not None:
+                    estimation.sensed(state, games)
+                if opponent is not None:
+                    opponent.sensed(state, games, rules.control_dt)
         rewards = state.rewards.reshape(self.num_games, rules.evaders)
         return rewards[:, 0].copy() if self.team_size == (1, 1) else rewards.copy()
 
     def observations(self, role: str, member: int = 0) -> np.ndarray:
         """Float32 (N, size): the observation of member ``member`` of ``role`` in every
-        game (a new array)."""
-        out = np.empty((self.num_games, self.features[role].size), dtype=np.float32)
+        game (a new array); a pursuer's belief part, with ``belief``, from each game's
+        estimation."""
+        features = self.features[role]
+        out = np.empty((self.num_games, features.size), dtype=np.float32)
         index = PURSUER if role == "pursuer" else EVADER
-        features(self.world, self.rules, self.state, out, index, member)
+        crop = features.layout["crop"].start
+        kernel_features(self.world, self.rules, self.state, out, index, member, crop)
+        belief = features.layout.get("belief")
+        if belief is not None and self.estimation is not None:
+            assert isinstance(features, PursuerFeatures)  # only a pursuer's has a belief
+            poses = self.state.poses
+            for game in range(self.num_games):
+                pose = Pose(*poses[game, PURSUER].tolist())
+                features.belief_part(out[game, belief], pose, self.estimation.belief(game))
         return out
 
     def time(self) -> np.ndarray:
@@ -299,9 +331,10 @@ class BatchedGame:
         team game): a pursuer strategy's opponent keeps them itself (with the
         estimator's), else the kernels' tally. The batched game keeps no loss causes
         (:mod:`pegame.losses`): ``loss_causes`` is None."""
-        metrics = getattr(self.opponent, "metrics", None)
-        if metrics is not None:
-            return {**metrics[game].summary(), "loss_causes": None}
+        if self.estimation is not None:
+            metrics = self.estimation.metrics[game]
+            assert metrics is not None  # the game was reset
+            return {**metrics.summary(), "loss_causes": None}
         dt, (n_p, n_e) = self.context.control_dt, self.team_size
         state = self.state
         if (n_p, n_e) == (1, 1):

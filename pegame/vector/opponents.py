@@ -14,9 +14,9 @@
   and its command at every tick. It costs what the strategy costs in a single game.
 - :class:`PursuerStrategyOpponent`: any other pursuer strategy, with what a pursuer
   strategy is given: its detection, the visibility region and the belief of the game's
-  estimator (one per game, built as Game builds it, updated every tick in Python as the
-  loop does), and that game's measures kept by :class:`pegame.metrics.TrackingMetrics`
-  itself (the estimator's included). It costs the strategy and the estimator per game.
+  estimator (:class:`pegame.vector.estimation.Estimation`: one per game, updated every
+  tick in Python as the loop does, and the game's measures with the estimator's). It
+  costs the strategy and the estimator per game.
 
 The action table ignores what it sees, so no estimator runs with it: its games' measures
 have no estimation error, n_eff or resamplings (None and 0).
@@ -28,36 +28,15 @@ from typing import Any
 
 import numpy as np
 
-from pegame.api import (
-    Context,
-    Estimator,
-    Evader,
-    EvaderObservation,
-    Pursuer,
-    PursuerObservation,
-)
+from pegame.api import Context, Evader, EvaderObservation, Pursuer, PursuerObservation
 from pegame.evaders.random import RandomEvader
 from pegame.evaders.smart import SmartEvader
 from pegame.evaders.smart_batch import SmartEvaderBatch, batchable
 from pegame.game import Scenario
-from pegame.metrics import TrackingMetrics
 from pegame.pursuers.random import RandomPursuer
-from pegame.types import BoundingBox, Detection, Pose
-from pegame.vector.state import (
-    BOX_H,
-    BOX_W,
-    BOX_X,
-    BOX_Y,
-    DEPTH,
-    EVADER,
-    PURSUER,
-    SEEN_X,
-    SEEN_Y,
-    V_MAX,
-    W_MAX,
-    BatchState,
-)
-from pegame.visibility import VisibilityRegion
+from pegame.types import Pose
+from pegame.vector.estimation import Estimation
+from pegame.vector.state import EVADER, PURSUER, V_MAX, W_MAX, BatchState
 
 
 class ActionTable:
@@ -152,8 +131,8 @@ class SmartEvaderOpponent:
 
 
 class PursuerStrategyOpponent:
-    """The pursuer strategy ``cls`` with ``config``, and the estimator ``estimator`` (a
-    (class, config) pair), in ``context``, one of each per game."""
+    """The pursuer strategy ``cls`` with ``config`` in ``context``, one per game, given
+    each game's detection, region and belief by the game's ``estimation``."""
 
     role = PURSUER
     table = None
@@ -162,77 +141,49 @@ class PursuerStrategyOpponent:
         self,
         cls: type[Pursuer],
         config: Any,
-        estimator: tuple[type[Estimator], Any],
+        estimation: Estimation,
         context: Context,
         num_games: int,
     ) -> None:
         self.cls, self.config, self.context = cls, config, context
-        self.estimator_cls, self.estimator_config = estimator
+        self.estimation = estimation
         self.strategies: list = [None] * num_games
-        self.estimators: list = [None] * num_games
-        self.metrics: list[TrackingMetrics | None] = [None] * num_games
-        self.seen: list = [None] * num_games  # (detection, region, belief) of the tick
 
     def reset(self, game: int, streams: dict, pose: Pose) -> None:
-        """A new strategy and estimator for ``game`` from ``streams``, reset at ``pose``."""
-        context = self.context
-        strategy = self.cls(self.config, context, np.random.default_rng(streams["pursuer"]))
+        """A new strategy for ``game`` from ``streams``, reset at ``pose``."""
+        strategy = self.cls(self.config, self.context, np.random.default_rng(streams["pursuer"]))
         strategy.reset(pose)
         self.strategies[game] = strategy
-        self.estimators[game] = self.estimator_cls(
-            self.estimator_config, context, np.random.default_rng(streams["estimator"])
-        )
-        self.metrics[game] = TrackingMetrics(context.control_dt)
 
     def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
-        """The loop's estimation after a tick is sensed (``_sense``): each game's region
-        at the pursuer's pose and its estimator's belief from the detection (a reset at
-        tick 0)."""
-        grid, camera = self.context.grid, self.context.camera
-        for game in games.tolist():
-            pose = Pose(*state.poses[game, PURSUER].tolist())
-            detection = None
-            if state.detected[game]:
-                row = state.detection[game]
-                box = BoundingBox(
-                    float(row[BOX_X]), float(row[BOX_Y]), float(row[BOX_W]), float(row[BOX_H])
-                )
-                position = (float(row[SEEN_X]), float(row[SEEN_Y]))
-                detection = Detection(box=box, depth=float(row[DEPTH]), position=position)
-            region = VisibilityRegion(grid, pose, camera)
-            estimator = self.estimators[game]
-            if state.steps[game] == 0:
-                belief = estimator.reset((pose,), (detection,), region)
-            else:
-                belief = estimator.update(dt, (pose,), (detection,), region)
-            self.seen[game] = (detection, region, belief)
+        """Nothing: the game's estimation runs after the tick is sensed."""
 
     def command(
         self, state: BatchState, games: np.ndarray, time: np.ndarray, deciding: np.ndarray
     ) -> None:
         """The strategies' commands for ``games`` at ``time[k]`` s (deciding first where
-        ``deciding[k]``) into state.commands, and the tick's measures (``metrics.add``)."""
-        poses, commands = state.poses, state.commands
+        ``deciding[k]``) into state.commands."""
+        poses, commands, seen = state.poses, state.commands, self.estimation.seen
         for k, game in enumerate(games.tolist()):
-            pursuer, evader = (
-                Pose(*poses[game, PURSUER].tolist()),
-                Pose(*poses[game, EVADER].tolist()),
-            )
-            detection, region, belief = self.seen[game]
+            pursuer = Pose(*poses[game, PURSUER].tolist())
+            detection, region, belief = seen[game]
             observation = PursuerObservation(float(time[k]), pursuer, detection, belief, region)
             strategy = self.strategies[game]
             if deciding[k]:
                 strategy.decide(observation)
             cmd = strategy.control(observation)
             commands[game, PURSUER, 0], commands[game, PURSUER, 1] = cmd.v, cmd.w
-            detected, in_view = bool(state.detected[game]), bool(state.in_view[game])
-            self.metrics[game].add(pursuer, evader, detected, in_view, belief)
 
 
 def opponent_for(
-    scenario: Scenario, learner: str, bodies: np.ndarray, num_games: int
+    scenario: Scenario,
+    learner: str,
+    bodies: np.ndarray,
+    num_games: int,
+    estimation: Estimation | None = None,
 ) -> ActionTable | SmartEvaderOpponent | StrategyOpponent | PursuerStrategyOpponent:
-    """The opponent of ``learner`` ('pursuer' or 'evader') in ``scenario``'s games."""
+    """The opponent of ``learner`` ('pursuer' or 'evader') in ``scenario``'s games; a
+    pursuer strategy takes its beliefs from ``estimation`` (see :func:`needs_estimation`)."""
     role = "evader" if learner == "pursuer" else "pursuer"
     cls, config = scenario.classes[role], scenario.configs[role]
     settings = scenario.settings
@@ -245,7 +196,14 @@ def opponent_for(
     if role == "evader":
         assert issubclass(cls, Evader)  # the scenario's classes implement their kinds
         return StrategyOpponent(cls, config, scenario.context, num_games)
-    estimator = scenario.classes["estimator"]
-    assert issubclass(cls, Pursuer) and issubclass(estimator, Estimator)
-    pair = (estimator, scenario.configs["estimator"])
-    return PursuerStrategyOpponent(cls, config, pair, scenario.context, num_games)
+    assert issubclass(cls, Pursuer) and estimation is not None
+    return PursuerStrategyOpponent(cls, config, estimation, scenario.context, num_games)
+
+
+def needs_estimation(scenario: Scenario, learner: str) -> bool:
+    """Whether the opponent of ``learner`` is a pursuer strategy (which needs the game's
+    estimation), not the batched random pursuer."""
+    if learner != "evader":
+        return False
+    cls, config = scenario.classes["pursuer"], scenario.configs["pursuer"]
+    return not (cls is RandomPursuer and config.model == "action")

@@ -131,6 +131,22 @@ def test_the_perception_model_plays_the_single_envs_games(conditions, role, oppo
     assert batched.game.state.drawn.sum() > 0  # the misses were drawn for
 
 
+@pytest.mark.parametrize(("opponent", "model"), [("random", "action"), ("smart", None)])
+def test_a_belief_observation_plays_the_single_envs_games(opponent, model):
+    """With ``belief=True`` each game runs the estimator in Python, as the single env
+    does: the belief part of the observation and the estimation measures are its own."""
+    overrides = SHORT + ([f"evader.model={model}"] if model else [])
+    settings = {"decision_period": 0.2, "belief": True}
+    batched = vector_env(2, overrides=overrides, opponent=opponent, **settings)
+    synced = SyncVectorEnv(
+        [lambda: PursuitEnv(overrides=overrides, opponent=opponent, **settings) for _ in range(2)]
+    )
+    ended = play_side_by_side(batched, synced, seed=3, steps=13, rng=np.random.default_rng(4))
+    assert ended == 2
+    belief = batched.layout["belief"]
+    assert np.any(batched.game.observations("pursuer")[:, belief] != 0.0)  # read, not zeros
+
+
 def test_evasion_against_random_actions_plays_the_single_envs_games():
     overrides = SHORT + ["pursuer.model=action"]
     batched = vector_env(2, overrides=overrides, opponent="random", role="evader")
@@ -171,9 +187,10 @@ def test_evasion_against_pursuer_strategies_plays_the_single_envs_games(opponent
     assert ended == 2
 
 
-def test_self_play_plays_the_parallel_envs_game():
-    batched = SelfPlayVectorEnv(1, overrides=SHORT)
-    single = parallel_env(overrides=SHORT)
+@pytest.mark.parametrize("belief", [False, True])
+def test_self_play_plays_the_parallel_envs_game(belief):
+    batched = SelfPlayVectorEnv(1, overrides=SHORT, belief=belief)
+    single = parallel_env(overrides=SHORT, belief=belief)
     obs_b, _ = batched.reset(seed=11)
     obs_s, _ = single.reset(seed=11)
     rng = np.random.default_rng(2)

@@ -35,9 +35,10 @@ def test_each_setting_it_does_not_play_is_refused_by_name(override, key, value, 
     assert "\n" not in message
 
 
-def test_a_belief_in_the_observation_is_refused():
+def test_a_belief_in_a_team_games_observation_is_refused():
+    team = ["env=hall", "team.pursuers=2"]
     with pytest.raises(ConfigError, match=r"'belief' in a batched env: True\. Allowed: False"):
-        vector_env(2, overrides=BASE, opponent="random", belief=True)
+        vector_env(2, overrides=team, role="both", belief=True)
 
 
 @pytest.mark.parametrize(("group", "name"), [("sim", "pybullet"), ("detector", "segmentation")])
