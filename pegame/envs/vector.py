@@ -237,7 +237,8 @@ class _LearnerVectorEnv(_Batch, VectorEnv):
         )
 
     def close_extras(self, **kwargs: Any) -> None:
-        """Nothing to release: the games hold no simulator processes."""
+        """Stop the opponent's threads, if any (the games hold no simulator processes)."""
+        self.game.close()
 
 
 class PursuitVectorEnv(_LearnerVectorEnv):
@@ -342,7 +343,7 @@ class SelfPlayVectorEnv(_Batch):
         )
 
     def close(self) -> None:
-        """Nothing to release."""
+        """Nothing to release: self-play has no opponent."""
 
 
 @overload

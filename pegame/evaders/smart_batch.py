@@ -110,6 +110,12 @@ class SmartEvaderBatch:
             self._threads = (pool, threads)
         return self._threads[0]
 
+    def close(self) -> None:
+        """Stop the threads, if any (a later command starts them again)."""
+        if self._threads is not None:
+            self._threads[0].shutdown()
+            self._threads = None
+
     def _thread_scratch(self, threads: int) -> tuple:
         """The escape search's and A*'s scratch memory, one slice per thread (the first
         axis), made for the most threads asked so far."""

@@ -314,6 +314,12 @@ class BatchedGame:
                 features.belief_part(out[game, belief], pose, self.estimation.belief(game))
         return out
 
+    def close(self) -> None:
+        """Release what the games hold beyond their arrays: the opponent's threads."""
+        close = getattr(self.opponent, "close", None)
+        if close is not None:
+            close()
+
     def time(self) -> np.ndarray:
         """Float64 (N,): every game's simulation time (s), as ``TickLoop.time``."""
         return self.state.steps * self.context.control_dt

@@ -129,6 +129,10 @@ class SmartEvaderOpponent:
         ``deciding[k]`` (the smart evader does not read the time)."""
         self.batch.command(state.poses, state.commands, games, deciding)
 
+    def close(self) -> None:
+        """Stop the batch's threads."""
+        self.batch.close()
+
 
 class PursuerStrategyOpponent:
     """The pursuer strategy ``cls`` with ``config`` in ``context``, one per game, given

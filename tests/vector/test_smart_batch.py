@@ -60,7 +60,12 @@ def test_games_on_two_threads_move_as_the_strategy(monkeypatch):
         env = assert_moves_as_the_strategy(["env=enclosed", "game.t_max=20"], n=6)
     finally:
         numba.set_num_threads(threads)
-    assert env.game.opponent.batch._threads[1] == 2
+    pool, count = env.game.opponent.batch._threads
+    assert count == 2
+    env.close()  # the env's close stops the threads
+    assert env.game.opponent.batch._threads is None
+    with pytest.raises(RuntimeError, match="shutdown"):
+        pool.submit(int)
 
 
 def assert_moves_as_the_strategy(overrides, n):
