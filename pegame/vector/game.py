@@ -257,8 +257,6 @@ class BatchedGame:
         kernels.sense_games(self.world, self.rules, state, games)
         if self.estimation is not None:
             self.estimation.sensed(state, games)
-        if opponent is not None:
-            opponent.sensed(state, games, self.context.control_dt)
 
     def step(self, playing: np.ndarray, commands: dict[str, np.ndarray]) -> np.ndarray:
         """One env step (``ticks_per_action`` control ticks) of the games where ``playing``
@@ -291,8 +289,6 @@ class BatchedGame:
                 kernels.play(self.world, rules, state, live, 1, table, played)
                 if estimation is not None:
                     estimation.sensed(state, games)
-                if opponent is not None:
-                    opponent.sensed(state, games, rules.control_dt)
         rewards = state.rewards.reshape(self.num_games, rules.evaders)
         return rewards[:, 0].copy() if self.team_size == (1, 1) else rewards.copy()
 

@@ -65,9 +65,6 @@ class ActionTable:
     ) -> None:
         """Nothing: the tick kernel reads the table."""
 
-    def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
-        """Nothing: the table does not look."""
-
 
 class StrategyOpponent:
     """The evader strategy ``cls`` with ``config`` in ``context``, one per game."""
@@ -85,9 +82,6 @@ class StrategyOpponent:
         strategy = self.cls(self.config, self.context, np.random.default_rng(streams["evader"]))
         strategy.reset(pose)
         self.strategies[game] = strategy
-
-    def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
-        """Nothing: the evader is told the poses when it is asked."""
 
     def command(
         self, state: BatchState, games: np.ndarray, time: np.ndarray, deciding: np.ndarray
@@ -118,9 +112,6 @@ class SmartEvaderOpponent:
     def reset(self, game: int, streams: dict, pose: Pose) -> None:
         """Game ``game`` starts (the smart evader draws nothing from its stream)."""
         self.batch.reset(game)
-
-    def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
-        """Nothing: the evader is told the poses when it is asked."""
 
     def command(
         self, state: BatchState, games: np.ndarray, time: np.ndarray, deciding: np.ndarray
@@ -158,9 +149,6 @@ class PursuerStrategyOpponent:
         strategy = self.cls(self.config, self.context, np.random.default_rng(streams["pursuer"]))
         strategy.reset(pose)
         self.strategies[game] = strategy
-
-    def sensed(self, state: BatchState, games: np.ndarray, dt: float) -> None:
-        """Nothing: the game's estimation runs after the tick is sensed."""
 
     def command(
         self, state: BatchState, games: np.ndarray, time: np.ndarray, deciding: np.ndarray
