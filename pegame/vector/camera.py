@@ -34,23 +34,31 @@ from pegame.detectors.oracle import image
 from pegame.detectors.perception import deliver_frame, frame_due, miss_chance, silhouette_hidden
 from pegame.numerics import hypot
 from pegame.vector.state import (
+    BEARING_DRAW,
+    BEARING_NOISE,
     BOX_H,
     BOX_W,
     BOX_X,
     BOX_Y,
     DEPTH,
+    DEPTH_DRAW,
     DETECTION_RANGE,
     FAR,
     FOV,
     LATENCY,
     MISS_AT_RANGE,
+    MISS_DRAW,
+    MISS_PROBABILITY,
     MISS_START,
     MISSES,
     NEAR,
+    NOISE_GROWTH,
+    NOISY,
     OCCLUSION_MISS,
     PERIOD,
     PIPELINE,
     RADIUS,
+    RANGE_NOISE,
     RATED,
     SEEN_X,
     SEEN_Y,
@@ -76,6 +84,8 @@ def detect(
     ey: float,
     draws: np.ndarray,
     drawn: np.ndarray,
+    noise: np.ndarray,
+    noise_drawn: np.ndarray,
     detected: np.ndarray,
     detection: np.ndarray,
     pair: int,
@@ -85,7 +95,10 @@ def detect(
     detector pair's; ``frame``, ``blocked``, ``values``: world.frame, world.blocked,
     world.sight_values; ``camera``: rules.camera, ``perception``: rules.perception,
     ``radius``: the evader's; a range or occlusion miss takes the next of the pair's
-    ``draws``, counted in ``drawn``). Returns whether the evader's centre is in view.
+    ``draws``, counted in ``drawn``; with the independent miss or the depth noise on, an
+    in-range capture takes the next (uniform, normal) pair of ``noise``, and with the
+    bearing noise a detection the next bearing error, counted in ``noise_drawn``, in the
+    order the oracle draws them). Returns whether the evader's centre is in view.
     (The functions here take the world's arrays, not the World: an inlined function
     given a NamedTuple pays a reference count per array.)"""
     near, far, fov = camera[NEAR], camera[FAR], camera[FOV]
@@ -95,6 +108,14 @@ def detect(
     distance = hypot(ex - cx, ey - cy)
     if not distance <= camera[DETECTION_RANGE]:
         return True
+    depth_error = 0.0
+    if perception[NOISY] != 0.0:  # the oracle draws both, every in-range capture
+        k = noise_drawn[pair, 0]
+        noise_drawn[pair, 0] += 1
+        if noise[pair, k, MISS_DRAW] < perception[MISS_PROBABILITY]:
+            return True
+        std = perception[RANGE_NOISE] + perception[NOISE_GROWTH] * distance**2
+        depth_error = std * noise[pair, k, DEPTH_DRAW]
     if perception[MISSES] != 0.0:
         hidden = 0.0
         if perception[OCCLUSION_MISS] > 0.0:
@@ -113,9 +134,13 @@ def detect(
         drawn[pair] += 1
         if draw < chance:
             return True
+    bearing_error = 0.0
+    if perception[BEARING_NOISE] != 0.0:
+        bearing_error = noise[pair, noise_drawn[pair, 1], BEARING_DRAW]
+        noise_drawn[pair, 1] += 1
     out, q = detection, pair
     box_x, box_y, box_w, box_h, depth, seen_x, seen_y = image(
-        camera, cx, cy, ctheta, ex, ey, distance, 0.0, 0.0, radius
+        camera, cx, cy, ctheta, ex, ey, distance, bearing_error, depth_error, radius
     )
     out[q, BOX_X], out[q, BOX_Y], out[q, BOX_W], out[q, BOX_H] = box_x, box_y, box_w, box_h
     out[q, DEPTH], out[q, SEEN_X], out[q, SEEN_Y] = depth, seen_x, seen_y
@@ -166,6 +191,8 @@ def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
                     ey,
                     state.draws,
                     state.drawn,
+                    state.noise,
+                    state.noise_drawn,
                     out,
                     rows,
                     q,

@@ -41,10 +41,12 @@ and the side-by-side test is the contract.
 
 What the batched game plays (anything else is a ConfigError at construction): the grid
 simulator; the oracle detector with the perception model's rate, latency, detection
-range and range and occlusion misses (every setting of ``+experiment=paper_conditions``
-but its turn order; the pipeline and the miss chance are the scalar detector's own
-kernels, :mod:`pegame.detectors.perception`), not its independent or bursty misses,
-noise, false positives or detection profile; ``game.turn_order=simultaneous``; the belief
+range, range and occlusion misses, independent misses and depth and bearing noise (every
+setting of ``+experiment=paper_conditions`` but its turn order; the pipeline and the miss
+chance are the scalar detector's own kernels, :mod:`pegame.detectors.perception`, and
+each detector pair's random numbers the oracle's, drawn ahead at a game's reset,
+:meth:`BatchedGame._draw_ahead`), not its bursty misses, false positives or detection
+profile; ``game.turn_order=simultaneous``; the belief
 in a 1v1 pursuer's observation (``belief=True``: the estimator runs per game in Python,
 :mod:`pegame.vector.estimation`, at a single game's cost); teams (``team.pursuers``,
 ``team.evaders``) when both roles learn, as the PettingZoo env plays them: every member
@@ -90,8 +92,11 @@ from pegame.vector.features import features as kernel_features
 from pegame.vector.metrics import new_tally, summary, team_summary
 from pegame.vector.opponents import needs_estimation, opponent_for
 from pegame.vector.state import (
+    BEARING_DRAW,
+    DEPTH_DRAW,
     DETECTED,
     EVADER,
+    MISS_DRAW,
     PURSUER,
     TICKS,
     BatchState,
@@ -103,11 +108,7 @@ from pegame.visibility.sight import sight_tables
 
 #: the oracle detector's perception fields the kernels play only off, and that value
 PERCEPTION_OFF = {
-    "miss_probability": 0.0,
     "burst_miss_fraction": 0.0,
-    "range_noise": 0.0,
-    "range_noise_growth": 0.0,
-    "bearing_noise": 0.0,
     "false_positive_rate": 0.0,
     "profile": None,
 }
@@ -175,7 +176,9 @@ class BatchedGame:
             for role, size in zip(("pursuer", "evader"), self.team_size)
             if role in self.roles
         }
-        self._misses = misses_by_range_or_occlusion(_detector(scenario))
+        detector = _detector(scenario)
+        self._misses = misses_by_range_or_occlusion(detector)
+        self._noisy = _noisy(detector)
         context = scenario.context
         self.context = context
         self.ticks_per_action = settings.ticks_per_action(context.control_dt)
@@ -190,6 +193,7 @@ class BatchedGame:
             _slots(scenario),
             _draws(scenario) if self._misses else 1,
             *self.team_size,
+            _draws(scenario) if self._noisy or detector.bearing_noise > 0 else 1,
         )
         self.state.tally[:] = new_tally()
         #: the loop's estimation per game, for a pursuer strategy or a belief observation
@@ -238,10 +242,8 @@ class BatchedGame:
                 opponent.reset(game, streams, first)
             if self.estimation is not None:
                 self.estimation.reset(game, streams)
-            if self._misses:  # each detector pair's 'range' part, drawn ahead
-                for q, seeded in enumerate(_detector_streams(seed, streams, n_p, n_e)):
-                    rng = part_generators(np.random.default_rng(seeded))["range"]
-                    state.draws[game * pairs + q] = rng.random(state.draws.shape[1])
+            for q, seeded in enumerate(_detector_streams(seed, streams, n_p, n_e)):
+                self._draw_ahead(game * pairs + q, np.random.default_rng(seeded))
         rows = {k: (games[:, None] * k + np.arange(k)).ravel() for k in (n_p, n_e, pairs)}
         state.velocities[games] = 0.0
         state.commands[games] = 0.0
@@ -254,9 +256,29 @@ class BatchedGame:
         state.detected[rows[pairs]] = False  # nothing delivered yet
         reset_pipeline(state.pipeline, rows[pairs])
         state.drawn[rows[pairs]] = 0
+        state.noise_drawn[rows[pairs]] = 0
         kernels.sense_games(self.world, self.rules, state, games)
         if self.estimation is not None:
             self.estimation.sensed(state, games)
+
+    def _draw_ahead(self, pair: int, rng: np.random.Generator) -> None:
+        """The random numbers detector pair row ``pair`` (its generator ``rng``, as the
+        oracle's) will take, drawn ahead in the oracle's order: its 'range' part's
+        uniforms; its own (uniform, normal) per in-range capture, the independent miss
+        and the depth noise, drawn together one capture after the other; its 'bearing'
+        part's errors."""
+        state, config = self.state, _detector(self.scenario)
+        parts = part_generators(rng)
+        if self._misses:
+            state.draws[pair] = parts["range"].random(state.draws.shape[1])
+        count = state.noise.shape[1]
+        if self._noisy:
+            pairs = [(rng.random(), rng.normal(0.0, 1.0)) for _ in range(count)]
+            state.noise[pair, :, MISS_DRAW : DEPTH_DRAW + 1] = pairs
+        if config.bearing_noise > 0:
+            state.noise[pair, :, BEARING_DRAW] = parts["bearing"].normal(
+                0.0, config.bearing_noise, count
+            )
 
     def step(self, playing: np.ndarray, commands: dict[str, np.ndarray]) -> np.ndarray:
         """One env step (``ticks_per_action`` control ticks) of the games where ``playing``
@@ -394,7 +416,7 @@ def _draws(scenario: Scenario) -> int:
 
 
 def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
-    """rules.perception (PERIOD..OCCLUSION_MISS) of the detector's ``config``."""
+    """rules.perception (PERIOD..BEARING_NOISE) of the detector's ``config``."""
     start = math.nan if config.miss_range_start is None else config.miss_range_start
     return np.array(
         [
@@ -406,9 +428,20 @@ def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
             start,
             config.miss_at_range,
             config.occlusion_miss,
+            float(_noisy(config)),
+            config.miss_probability,
+            config.range_noise,
+            config.range_noise_growth,
+            config.bearing_noise,
         ],
         dtype=np.float64,
     )
+
+
+def _noisy(config: PerceptionConfig) -> bool:
+    """Whether an in-range capture's independent-miss and depth-noise draws matter (the
+    oracle draws them always; the batched game draws them ahead only when they do)."""
+    return config.miss_probability > 0 or config.range_noise > 0 or config.range_noise_growth > 0
 
 
 def _rules(scenario: Scenario) -> Rules:

@@ -105,16 +105,32 @@ PERCEPTION = {
         "detector.miss_at_range=0.8",
         "detector.occlusion_miss=0.5",
     ],
+    "noise": [
+        "detector.miss_probability=0.3",
+        "detector.range_noise=0.05",
+        "detector.range_noise_growth=0.02",
+        "detector.bearing_noise=0.03",
+        "detector.miss_range_start=1",
+        "detector.miss_at_range=0.5",
+        "detector.rate=5",
+    ],
 }
 
 
 @pytest.mark.parametrize(
     ("conditions", "role", "opponent"),
-    [("paper", "pursuer", "smart"), ("parts", "pursuer", "random"), ("paper", "evader", "smart")],
+    [
+        ("paper", "pursuer", "smart"),
+        ("parts", "pursuer", "random"),
+        ("paper", "evader", "smart"),
+        ("noise", "pursuer", "random"),
+    ],
 )
 def test_the_perception_model_plays_the_single_envs_games(conditions, role, opponent):
-    """Rate, latency, detection range and the range and occlusion misses: the pipeline
-    and the miss chance are the scalar detector's kernels, run on the batch."""
+    """Rate, latency, detection range, the range and occlusion misses, the independent
+    misses and the depth and bearing noise: the pipeline and the miss chance are the
+    scalar detector's kernels, run on the batch, and the draws are the oracle's, drawn
+    ahead in its order."""
     overrides = ["env=enclosed", *PERCEPTION[conditions], "game.t_max=4"]
     if opponent == "random":
         overrides.append(f"{'evader' if role == 'pursuer' else 'pursuer'}.model=action")
@@ -129,6 +145,8 @@ def test_the_perception_model_plays_the_single_envs_games(conditions, role, oppo
     ended = play_side_by_side(batched, synced, seed=2, steps=24, rng=np.random.default_rng(6))
     assert ended == 3
     assert batched.game.state.drawn.sum() > 0  # the misses were drawn for
+    if conditions == "noise":
+        assert (batched.game.state.noise_drawn > 0).all(axis=0).any()
 
 
 @pytest.mark.parametrize(("opponent", "model"), [("random", "action"), ("smart", None)])
@@ -285,8 +303,8 @@ def test_bad_actions_and_unsupported_configs_are_clear_errors():
         env.step(np.full((2, 2), 2.0, np.float32))
     with pytest.raises(ValueError, match="shape"):
         env.step(np.zeros((3, 2), np.float32))
-    with pytest.raises(ConfigError, match="detector.miss_probability"):
-        vector_env(2, overrides=SHORT + ["detector.miss_probability=0.1"])
+    with pytest.raises(ConfigError, match="detector.false_positive_rate"):
+        vector_env(2, overrides=SHORT + ["detector.false_positive_rate=0.1"])
     with pytest.raises(ConfigError, match="role"):
         vector_env(2, overrides=SHORT, role="referee")
 

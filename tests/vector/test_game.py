@@ -15,11 +15,7 @@ BASE = ["env=hall", "evader.model=action"]
 @pytest.mark.parametrize(
     ("override", "key", "value", "allowed"),
     [
-        ("detector.miss_probability=0.1", "detector.miss_probability", "0.1", "0.0"),
         ("detector.burst_miss_fraction=0.2", "detector.burst_miss_fraction", "0.2", "0.0"),
-        ("detector.range_noise=0.05", "detector.range_noise", "0.05", "0.0"),
-        ("detector.range_noise_growth=0.01", "detector.range_noise_growth", "0.01", "0.0"),
-        ("detector.bearing_noise=0.02", "detector.bearing_noise", "0.02", "0.0"),
         ("detector.false_positive_rate=0.1", "detector.false_positive_rate", "0.1", "0.0"),
         ("team.pursuers=2", "team.pursuers", "2", "1"),
         ("team.evaders=3", "team.evaders", "3", "1"),
@@ -61,9 +57,11 @@ def test_paper_conditions_are_refused_for_their_turn_order_only():
 
 
 def test_several_settings_are_refused_in_one_paragraph():
-    overrides = [*BASE, "detector.bearing_noise=0.1", "team.evaders=2"]
+    overrides = [*BASE, "detector.false_positive_rate=0.1", "team.evaders=2"]
     with pytest.raises(ConfigError) as error:
         vector_env(2, overrides=overrides, opponent="random")
     message = str(error.value)
-    assert message.startswith("Invalid values in a batched env: 'detector.bearing_noise': 0.1 ")
+    assert message.startswith(
+        "Invalid values in a batched env: 'detector.false_positive_rate': 0.1 "
+    )
     assert "; 'team.evaders': 2 (allowed: 1" in message and "\n" not in message
