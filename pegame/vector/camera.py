@@ -40,6 +40,9 @@ from pegame.vector.state import (
     BOX_W,
     BOX_X,
     BOX_Y,
+    BURST_DRAW,
+    BURST_FRACTION,
+    BURST_LENGTH,
     DEPTH,
     DEPTH_DRAW,
     DETECTION_RANGE,
@@ -149,6 +152,25 @@ def detect(
 
 
 @njit(cache=True, inline="always")
+def burst_step(perception: np.ndarray, state: BatchState, pair: int, dt: float) -> bool:
+    """The perception model's Gilbert-Elliott chain (``Perception._burst_step``) of
+    detector pair row ``pair`` over ``dt`` s, on its next 'burst' draw; True when this
+    frame is missed."""
+    f, length = perception[BURST_FRACTION], perception[BURST_LENGTH]
+    k = state.noise_drawn[pair, 2]
+    state.noise_drawn[pair, 2] += 1
+    draw = state.noise[pair, k, BURST_DRAW]
+    if state.bursting[pair] < 0:
+        bursting = draw < f  # the stationary law
+    elif state.bursting[pair] == 1:
+        bursting = draw >= min(1.0, dt / length)
+    else:
+        bursting = draw < min(1.0, dt * f / (length * (1 - f)))
+    state.bursting[pair] = 1 if bursting else 0
+    return bursting
+
+
+@njit(cache=True, inline="always")
 def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
     """The loop's ``_sense`` for ``game``: per detector pair (pursuer i, evader j) in
     order, the detection, then ground truth in_view; then each pursuer observation's
@@ -172,9 +194,9 @@ def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
         for j in range(n_e):
             q = (game * n_p + i) * n_e + j
             ex, ey = poses[game, n_p + j, 0], poses[game, n_p + j, 1]
-            due = True
+            due, since = True, 0.0
             if pipeline:
-                due, _ = frame_due(state.pipeline, q, time, period, rated)
+                due, since = frame_due(state.pipeline, q, time, period, rated)
             if due:
                 out, rows = (state.captured, state.capture) if pipeline else (detected, detection)
                 centre = detect(
@@ -197,6 +219,8 @@ def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
                     rows,
                     q,
                 )
+                if perception[BURST_FRACTION] > 0.0 and burst_step(perception, state, q, since):
+                    state.captured[q] = False  # the frame is lost in a burst
             else:
                 centre = point_in_view(
                     frame, blocked, values, near, far, fov, px, py, ptheta, ex, ey

@@ -41,12 +41,12 @@ and the side-by-side test is the contract.
 
 What the batched game plays (anything else is a ConfigError at construction): the grid
 simulator; the oracle detector with the perception model's rate, latency, detection
-range, range and occlusion misses, independent misses and depth and bearing noise (every
-setting of ``+experiment=paper_conditions`` but its turn order; the pipeline and the miss
-chance are the scalar detector's own kernels, :mod:`pegame.detectors.perception`, and
-each detector pair's random numbers the oracle's, drawn ahead at a game's reset,
-:meth:`BatchedGame._draw_ahead`), not its bursty misses, false positives or detection
-profile; ``game.turn_order=simultaneous``; the belief
+range, range and occlusion misses, independent and bursty misses and depth and bearing
+noise (every setting of ``+experiment=paper_conditions`` but its turn order; the pipeline
+and the miss chance are the scalar detector's own kernels,
+:mod:`pegame.detectors.perception`, and each detector pair's random numbers the
+oracle's, drawn ahead at a game's reset, :meth:`BatchedGame._draw_ahead`), not its false
+positives or detection profile; ``game.turn_order=simultaneous``; the belief
 in a 1v1 pursuer's observation (``belief=True``: the estimator runs per game in Python,
 :mod:`pegame.vector.estimation`, at a single game's cost); teams (``team.pursuers``,
 ``team.evaders``) when both roles learn, as the PettingZoo env plays them: every member
@@ -93,6 +93,7 @@ from pegame.vector.metrics import new_tally, summary, team_summary
 from pegame.vector.opponents import needs_estimation, opponent_for
 from pegame.vector.state import (
     BEARING_DRAW,
+    BURST_DRAW,
     DEPTH_DRAW,
     DETECTED,
     EVADER,
@@ -108,7 +109,6 @@ from pegame.visibility.sight import sight_tables
 
 #: the oracle detector's perception fields the kernels play only off, and that value
 PERCEPTION_OFF = {
-    "burst_miss_fraction": 0.0,
     "false_positive_rate": 0.0,
     "profile": None,
 }
@@ -193,7 +193,7 @@ class BatchedGame:
             _slots(scenario),
             _draws(scenario) if self._misses else 1,
             *self.team_size,
-            _draws(scenario) if self._noisy or detector.bearing_noise > 0 else 1,
+            _draws(scenario) if self._noisy or _errs(detector) else 1,
         )
         self.state.tally[:] = new_tally()
         #: the loop's estimation per game, for a pursuer strategy or a belief observation
@@ -257,6 +257,7 @@ class BatchedGame:
         reset_pipeline(state.pipeline, rows[pairs])
         state.drawn[rows[pairs]] = 0
         state.noise_drawn[rows[pairs]] = 0
+        state.bursting[rows[pairs]] = -1
         kernels.sense_games(self.world, self.rules, state, games)
         if self.estimation is not None:
             self.estimation.sensed(state, games)
@@ -266,7 +267,7 @@ class BatchedGame:
         oracle's) will take, drawn ahead in the oracle's order: its 'range' part's
         uniforms; its own (uniform, normal) per in-range capture, the independent miss
         and the depth noise, drawn together one capture after the other; its 'bearing'
-        part's errors."""
+        part's errors; its 'burst' part's uniforms, one per captured frame."""
         state, config = self.state, _detector(self.scenario)
         parts = part_generators(rng)
         if self._misses:
@@ -279,6 +280,8 @@ class BatchedGame:
             state.noise[pair, :, BEARING_DRAW] = parts["bearing"].normal(
                 0.0, config.bearing_noise, count
             )
+        if config.burst_miss_fraction > 0:
+            state.noise[pair, :, BURST_DRAW] = parts["burst"].random(count)
 
     def step(self, playing: np.ndarray, commands: dict[str, np.ndarray]) -> np.ndarray:
         """One env step (``ticks_per_action`` control ticks) of the games where ``playing``
@@ -416,7 +419,7 @@ def _draws(scenario: Scenario) -> int:
 
 
 def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
-    """rules.perception (PERIOD..BEARING_NOISE) of the detector's ``config``."""
+    """rules.perception (PERIOD..BURST_LENGTH) of the detector's ``config``."""
     start = math.nan if config.miss_range_start is None else config.miss_range_start
     return np.array(
         [
@@ -433,9 +436,16 @@ def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
             config.range_noise,
             config.range_noise_growth,
             config.bearing_noise,
+            config.burst_miss_fraction,
+            config.burst_length,
         ],
         dtype=np.float64,
     )
+
+
+def _errs(config: PerceptionConfig) -> bool:
+    """Whether the bearing noise or the bursts take draws of their own."""
+    return config.bearing_noise > 0 or config.burst_miss_fraction > 0
 
 
 def _noisy(config: PerceptionConfig) -> bool:

@@ -38,12 +38,15 @@ PURSUER, EVADER = 0, 1
 #: whether the range or occlusion miss is on, miss_range_start (m, NaN: off),
 #: miss_at_range, occlusion_miss; whether the independent miss or the depth noise is on
 #: (each in-range capture then takes a (uniform, normal) pair of the detector's own
-#: draws), miss_probability, range_noise (m), range_noise_growth (1/m), bearing_noise (rad)
+#: draws), miss_probability, range_noise (m), range_noise_growth (1/m), bearing_noise (rad),
+#: burst_miss_fraction, burst_length (s)
 PERIOD, RATED, LATENCY, PIPELINE, MISSES, MISS_START, MISS_AT_RANGE, OCCLUSION_MISS = range(8)
 NOISY, MISS_PROBABILITY, RANGE_NOISE, NOISE_GROWTH, BEARING_NOISE = range(8, 13)
+BURST_FRACTION, BURST_LENGTH = range(13, 15)
 #: columns of ``state.noise``: the detector's uniform and normal of an in-range capture
-#: (the independent miss and the depth noise), the 'bearing' part's error (rad)
-MISS_DRAW, DEPTH_DRAW, BEARING_DRAW = range(3)
+#: (the independent miss and the depth noise), the 'bearing' part's error (rad), the
+#: 'burst' part's uniform of a captured frame
+MISS_DRAW, DEPTH_DRAW, BEARING_DRAW, BURST_DRAW = range(4)
 #: columns of ``state.detection``: the box (px), the depth (m) and the map position (m)
 BOX_X, BOX_Y, BOX_W, BOX_H, DEPTH, SEEN_X, SEEN_Y = range(7)
 DETECTION_SIZE = 7
@@ -116,7 +119,7 @@ class Rules(NamedTuple):
     bodies: (A, 5) float64 per agent (the pursuers, then the evaders): radius (m), v_max
     (m/s), w_max (rad/s), a_max (m/s^2), alpha_max (rad/s^2); camera: float64 (9,) as the constants
     FOV..CAMERA_HEIGHT (:func:`pegame.detectors.oracle.camera_numbers`); perception:
-    float64 (13,) as the constants PERIOD..BEARING_NOISE; control_dt (s); substeps per
+    float64 (15,) as the constants PERIOD..BURST_LENGTH; control_dt (s); substeps per
     control tick; decide_every: control ticks per decision; ticks: control ticks per game;
     pursuers, evaders: the team sizes P and E (1 and 1 in a 1v1 game).
     """
@@ -155,9 +158,10 @@ class BatchState(NamedTuple):
     captured and capture (., 7): the tick's own capture; in_flight_detected (., K) and
     in_flight (., K, 7): the results in flight by slot; draws (., D): each pair's range
     stream drawn ahead (the range and occlusion misses), drawn of them used; noise (., D,
-    3): each pair's draws of the independent miss, the depth noise and the bearing noise
-    drawn ahead (columns MISS_DRAW..BEARING_DRAW), noise_drawn (., 2) of them used (the
-    first two columns, then the third).
+    4): each pair's draws of the independent miss, the depth noise, the bearing noise and
+    the bursts drawn ahead (columns MISS_DRAW..BURST_DRAW), noise_drawn (., 3) of them
+    used (the first two columns, the third, the fourth); bursting: each pair's burst
+    chain (-1 undrawn, 0 between bursts, 1 in one).
     """
 
     poses: np.ndarray
@@ -180,6 +184,7 @@ class BatchState(NamedTuple):
     drawn: np.ndarray
     noise: np.ndarray
     noise_drawn: np.ndarray
+    bursting: np.ndarray
     crew: np.ndarray
     trackers: np.ndarray
     handoffs: np.ndarray
@@ -216,8 +221,9 @@ def new_state(
         np.zeros((pairs, slots, DETECTION_SIZE)),
         np.zeros((pairs, draws)),
         np.zeros(pairs, np.int64),
-        np.zeros((pairs, noise, 3)),
-        np.zeros((pairs, 2), np.int64),
+        np.zeros((pairs, noise, 4)),
+        np.zeros((pairs, 3), np.int64),
+        np.full(pairs, -1, np.int64),
         np.zeros((crew, CREW_SIZE)),
         np.full(members, -1, np.int64),
         np.zeros(n),

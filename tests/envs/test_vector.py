@@ -113,6 +113,8 @@ PERCEPTION = {
         "detector.miss_range_start=1",
         "detector.miss_at_range=0.5",
         "detector.rate=5",
+        "detector.burst_miss_fraction=0.3",
+        "detector.burst_length=0.4",
     ],
 }
 
@@ -145,8 +147,8 @@ def test_the_perception_model_plays_the_single_envs_games(conditions, role, oppo
     ended = play_side_by_side(batched, synced, seed=2, steps=24, rng=np.random.default_rng(6))
     assert ended == 3
     assert batched.game.state.drawn.sum() > 0  # the misses were drawn for
-    if conditions == "noise":
-        assert (batched.game.state.noise_drawn > 0).all(axis=0).any()
+    if conditions == "noise":  # each kind of draw taken in some game
+        assert (batched.game.state.noise_drawn.max(axis=0) > 0).all()
 
 
 @pytest.mark.parametrize(("opponent", "model"), [("random", "action"), ("smart", None)])

@@ -15,7 +15,6 @@ BASE = ["env=hall", "evader.model=action"]
 @pytest.mark.parametrize(
     ("override", "key", "value", "allowed"),
     [
-        ("detector.burst_miss_fraction=0.2", "detector.burst_miss_fraction", "0.2", "0.0"),
         ("detector.false_positive_rate=0.1", "detector.false_positive_rate", "0.1", "0.0"),
         ("team.pursuers=2", "team.pursuers", "2", "1"),
         ("team.evaders=3", "team.evaders", "3", "1"),
