@@ -27,15 +27,24 @@ Units: SI, map frame.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from pegame.detectors.oracle import image
-from pegame.detectors.perception import deliver_frame, frame_due, miss_chance, silhouette_hidden
+from pegame.detectors.perception import (
+    deliver_frame,
+    frame_due,
+    miss_chance,
+    pinhole,
+    silhouette_hidden,
+)
 from pegame.numerics import hypot
 from pegame.vector.state import (
     BEARING_DRAW,
     BEARING_NOISE,
+    BODY_HEIGHT,
     BOX_H,
     BOX_W,
     BOX_X,
@@ -43,11 +52,17 @@ from pegame.vector.state import (
     BURST_DRAW,
     BURST_FRACTION,
     BURST_LENGTH,
+    CAMERA_HEIGHT,
     DEPTH,
     DEPTH_DRAW,
     DETECTION_RANGE,
+    FALSE_POSITIVE_DRAW,
+    FALSE_POSITIVE_RATE,
     FAR,
+    FOCAL,
     FOV,
+    IMAGE_HEIGHT,
+    IMAGE_WIDTH,
     LATENCY,
     MISS_AT_RANGE,
     MISS_DRAW,
@@ -171,6 +186,56 @@ def burst_step(perception: np.ndarray, state: BatchState, pair: int, dt: float) 
 
 
 @njit(cache=True, inline="always")
+def false_positive(
+    camera: np.ndarray,
+    perception: np.ndarray,
+    state: BatchState,
+    pair: int,
+    dt: float,
+    px: float,
+    py: float,
+    ptheta: float,
+    radius: float,
+) -> None:
+    """The perception model's false positive (``Perception._false_positive``) of a frame
+    of detector pair row ``pair`` without a detection, ``dt`` s after its last frame, by
+    the camera at (px, py, ptheta): when one arrived (a uniform below 1 - exp(-rate dt)),
+    a body of the evader's ``radius`` at a uniform bearing in the field of view and a
+    distance uniform over the area within the detection range, into state.capture and
+    state.captured; the uniforms are the pair's 'false_positive' draws in turn."""
+    k = state.noise_drawn[pair, 3]
+    draws = state.noise[pair]
+    arrived = draws[k // 3, FALSE_POSITIVE_DRAW + k % 3]
+    if arrived >= -math.expm1(-perception[FALSE_POSITIVE_RATE] * dt):
+        state.noise_drawn[pair, 3] = k + 1
+        return
+    u1 = draws[(k + 1) // 3, FALSE_POSITIVE_DRAW + (k + 1) % 3]
+    u2 = draws[(k + 2) // 3, FALSE_POSITIVE_DRAW + (k + 2) % 3]
+    state.noise_drawn[pair, 3] = k + 3
+    fov, near, reach = camera[FOV], camera[NEAR], camera[DETECTION_RANGE]
+    bearing = -0.5 * fov + (0.5 * fov - -0.5 * fov) * u1  # numpy's uniform(low, high)
+    distance = math.sqrt(near**2 + (reach**2 - near**2) * u2)
+    depth = max(near, distance * math.cos(bearing))
+    x, y, w, h = pinhole(
+        camera[IMAGE_WIDTH],
+        camera[IMAGE_HEIGHT],
+        camera[FOCAL],
+        bearing,
+        distance,
+        depth,
+        radius,
+        camera[BODY_HEIGHT],
+        camera[CAMERA_HEIGHT],
+    )
+    heading = ptheta + bearing
+    out, q = state.capture, pair
+    out[q, BOX_X], out[q, BOX_Y], out[q, BOX_W], out[q, BOX_H], out[q, DEPTH] = x, y, w, h, depth
+    out[q, SEEN_X] = px + distance * math.cos(heading)
+    out[q, SEEN_Y] = py + distance * math.sin(heading)
+    state.captured[q] = True
+
+
+@njit(cache=True, inline="always")
 def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
     """The loop's ``_sense`` for ``game``: per detector pair (pursuer i, evader j) in
     order, the detection, then ground truth in_view; then each pursuer observation's
@@ -221,6 +286,8 @@ def sense(world: World, rules: Rules, state: BatchState, game: int) -> None:
                 )
                 if perception[BURST_FRACTION] > 0.0 and burst_step(perception, state, q, since):
                     state.captured[q] = False  # the frame is lost in a burst
+                if perception[FALSE_POSITIVE_RATE] > 0.0 and not state.captured[q]:
+                    false_positive(camera, perception, state, q, since, px, py, ptheta, radius)
             else:
                 centre = point_in_view(
                     frame, blocked, values, near, far, fov, px, py, ptheta, ex, ey

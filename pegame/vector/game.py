@@ -41,12 +41,12 @@ and the side-by-side test is the contract.
 
 What the batched game plays (anything else is a ConfigError at construction): the grid
 simulator; the oracle detector with the perception model's rate, latency, detection
-range, range and occlusion misses, independent and bursty misses and depth and bearing
+range, range and occlusion misses, independent and bursty misses, depth and bearing
 noise (every setting of ``+experiment=paper_conditions`` but its turn order; the pipeline
 and the miss chance are the scalar detector's own kernels,
 :mod:`pegame.detectors.perception`, and each detector pair's random numbers the
-oracle's, drawn ahead at a game's reset, :meth:`BatchedGame._draw_ahead`), not its false
-positives or detection profile; ``game.turn_order=simultaneous``; the belief
+oracle's, drawn ahead at a game's reset, :meth:`BatchedGame._draw_ahead`), and its false
+positives, but not a detection profile; ``game.turn_order=simultaneous``; the belief
 in a 1v1 pursuer's observation (``belief=True``: the estimator runs per game in Python,
 :mod:`pegame.vector.estimation`, at a single game's cost); teams (``team.pursuers``,
 ``team.evaders``) when both roles learn, as the PettingZoo env plays them: every member
@@ -97,6 +97,7 @@ from pegame.vector.state import (
     DEPTH_DRAW,
     DETECTED,
     EVADER,
+    FALSE_POSITIVE_DRAW,
     MISS_DRAW,
     PURSUER,
     TICKS,
@@ -108,10 +109,7 @@ from pegame.vector.state import (
 from pegame.visibility.sight import sight_tables
 
 #: the oracle detector's perception fields the kernels play only off, and that value
-PERCEPTION_OFF = {
-    "false_positive_rate": 0.0,
-    "profile": None,
-}
+PERCEPTION_OFF = {"profile": None}
 
 
 def check_playable(scenario: Scenario, settings: EnvSettings, roles: Sequence[str]) -> None:
@@ -267,7 +265,9 @@ class BatchedGame:
         oracle's) will take, drawn ahead in the oracle's order: its 'range' part's
         uniforms; its own (uniform, normal) per in-range capture, the independent miss
         and the depth noise, drawn together one capture after the other; its 'bearing'
-        part's errors; its 'burst' part's uniforms, one per captured frame."""
+        part's errors; its 'burst' part's uniforms, one per captured frame; its
+        'false_positive' part's uniforms, one per frame without a detection and two more
+        per false positive."""
         state, config = self.state, _detector(self.scenario)
         parts = part_generators(rng)
         if self._misses:
@@ -282,6 +282,9 @@ class BatchedGame:
             )
         if config.burst_miss_fraction > 0:
             state.noise[pair, :, BURST_DRAW] = parts["burst"].random(count)
+        if config.false_positive_rate > 0:
+            uniforms = parts["false_positive"].random(3 * count).reshape(count, 3)
+            state.noise[pair, :, FALSE_POSITIVE_DRAW:] = uniforms
 
     def step(self, playing: np.ndarray, commands: dict[str, np.ndarray]) -> np.ndarray:
         """One env step (``ticks_per_action`` control ticks) of the games where ``playing``
@@ -419,7 +422,7 @@ def _draws(scenario: Scenario) -> int:
 
 
 def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
-    """rules.perception (PERIOD..BURST_LENGTH) of the detector's ``config``."""
+    """rules.perception (PERIOD..FALSE_POSITIVE_RATE) of the detector's ``config``."""
     start = math.nan if config.miss_range_start is None else config.miss_range_start
     return np.array(
         [
@@ -438,14 +441,17 @@ def _perception(config: PerceptionConfig, control_dt: float) -> np.ndarray:
             config.bearing_noise,
             config.burst_miss_fraction,
             config.burst_length,
+            config.false_positive_rate,
         ],
         dtype=np.float64,
     )
 
 
 def _errs(config: PerceptionConfig) -> bool:
-    """Whether the bearing noise or the bursts take draws of their own."""
-    return config.bearing_noise > 0 or config.burst_miss_fraction > 0
+    """Whether the bearing noise, the bursts or the false positives take draws."""
+    return (
+        config.bearing_noise > 0 or config.burst_miss_fraction > 0 or config.false_positive_rate > 0
+    )
 
 
 def _noisy(config: PerceptionConfig) -> bool:

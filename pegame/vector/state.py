@@ -39,14 +39,17 @@ PURSUER, EVADER = 0, 1
 #: miss_at_range, occlusion_miss; whether the independent miss or the depth noise is on
 #: (each in-range capture then takes a (uniform, normal) pair of the detector's own
 #: draws), miss_probability, range_noise (m), range_noise_growth (1/m), bearing_noise (rad),
-#: burst_miss_fraction, burst_length (s)
+#: burst_miss_fraction, burst_length (s), false_positive_rate (1/s)
 PERIOD, RATED, LATENCY, PIPELINE, MISSES, MISS_START, MISS_AT_RANGE, OCCLUSION_MISS = range(8)
 NOISY, MISS_PROBABILITY, RANGE_NOISE, NOISE_GROWTH, BEARING_NOISE = range(8, 13)
-BURST_FRACTION, BURST_LENGTH = range(13, 15)
+BURST_FRACTION, BURST_LENGTH, FALSE_POSITIVE_RATE = range(13, 16)
 #: columns of ``state.noise``: the detector's uniform and normal of an in-range capture
 #: (the independent miss and the depth noise), the 'bearing' part's error (rad), the
-#: 'burst' part's uniform of a captured frame
-MISS_DRAW, DEPTH_DRAW, BEARING_DRAW, BURST_DRAW = range(4)
+#: 'burst' part's uniform of a captured frame, and from FALSE_POSITIVE_DRAW on three
+#: columns of the 'false_positive' part's uniforms, taken in row order (one per frame
+#: without a detection, two more for a false positive)
+MISS_DRAW, DEPTH_DRAW, BEARING_DRAW, BURST_DRAW, FALSE_POSITIVE_DRAW = range(5)
+NOISE_COLUMNS = 7
 #: columns of ``state.detection``: the box (px), the depth (m) and the map position (m)
 BOX_X, BOX_Y, BOX_W, BOX_H, DEPTH, SEEN_X, SEEN_Y = range(7)
 DETECTION_SIZE = 7
@@ -119,7 +122,7 @@ class Rules(NamedTuple):
     bodies: (A, 5) float64 per agent (the pursuers, then the evaders): radius (m), v_max
     (m/s), w_max (rad/s), a_max (m/s^2), alpha_max (rad/s^2); camera: float64 (9,) as the constants
     FOV..CAMERA_HEIGHT (:func:`pegame.detectors.oracle.camera_numbers`); perception:
-    float64 (15,) as the constants PERIOD..BURST_LENGTH; control_dt (s); substeps per
+    float64 (16,) as the constants PERIOD..FALSE_POSITIVE_RATE; control_dt (s); substeps per
     control tick; decide_every: control ticks per decision; ticks: control ticks per game;
     pursuers, evaders: the team sizes P and E (1 and 1 in a 1v1 game).
     """
@@ -158,10 +161,11 @@ class BatchState(NamedTuple):
     captured and capture (., 7): the tick's own capture; in_flight_detected (., K) and
     in_flight (., K, 7): the results in flight by slot; draws (., D): each pair's range
     stream drawn ahead (the range and occlusion misses), drawn of them used; noise (., D,
-    4): each pair's draws of the independent miss, the depth noise, the bearing noise and
-    the bursts drawn ahead (columns MISS_DRAW..BURST_DRAW), noise_drawn (., 3) of them
-    used (the first two columns, the third, the fourth); bursting: each pair's burst
-    chain (-1 undrawn, 0 between bursts, 1 in one).
+    NOISE_COLUMNS): each pair's draws of the independent miss, the depth noise, the
+    bearing noise, the bursts and the false positives drawn ahead (columns
+    MISS_DRAW..FALSE_POSITIVE_DRAW), noise_drawn (., 4) of them used (the first two
+    columns, the third, the fourth, the last three); bursting: each pair's burst chain
+    (-1 undrawn, 0 between bursts, 1 in one).
     """
 
     poses: np.ndarray
@@ -221,8 +225,8 @@ def new_state(
         np.zeros((pairs, slots, DETECTION_SIZE)),
         np.zeros((pairs, draws)),
         np.zeros(pairs, np.int64),
-        np.zeros((pairs, noise, 4)),
-        np.zeros((pairs, 3), np.int64),
+        np.zeros((pairs, noise, NOISE_COLUMNS)),
+        np.zeros((pairs, 4), np.int64),
         np.full(pairs, -1, np.int64),
         np.zeros((crew, CREW_SIZE)),
         np.full(members, -1, np.int64),

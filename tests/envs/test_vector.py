@@ -115,6 +115,7 @@ PERCEPTION = {
         "detector.rate=5",
         "detector.burst_miss_fraction=0.3",
         "detector.burst_length=0.4",
+        "detector.false_positive_rate=2",
     ],
 }
 
@@ -305,8 +306,8 @@ def test_bad_actions_and_unsupported_configs_are_clear_errors():
         env.step(np.full((2, 2), 2.0, np.float32))
     with pytest.raises(ValueError, match="shape"):
         env.step(np.zeros((3, 2), np.float32))
-    with pytest.raises(ConfigError, match="detector.false_positive_rate"):
-        vector_env(2, overrides=SHORT + ["detector.false_positive_rate=0.1"])
+    with pytest.raises(ConfigError, match="game.turn_order"):
+        vector_env(2, overrides=SHORT + ["game.turn_order=evader_first"])
     with pytest.raises(ConfigError, match="role"):
         vector_env(2, overrides=SHORT, role="referee")
 
