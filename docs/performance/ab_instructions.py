@@ -22,8 +22,9 @@ the decisions on their own, 20 each: ``filter`` (particle filter updates, 2000 p
 regions given), ``pursuer`` (smart pursuer decisions, each after its filter update),
 ``evader`` (smart evader decisions); ``sim`` (2000 grid-simulator steps), ``game`` (one
 90 s S-S game, seed 0, recorder=none), ``recorded`` (the same game with recorder=rerun:
-its Ir less the game's is the recording's) and ``env`` (one PettingZoo episode of random
-actions, seed 0). A side takes about two minutes a workload; the sides run two at a time
+its Ir less the game's is the recording's), ``env`` (one PettingZoo episode of random
+actions, seed 0) and ``vector`` (a reset and 30 steps of the batched env of 128 games
+against the random evader, on one thread). A side takes about two minutes a workload; the sides run two at a time
 (``--jobs``).
 """
 
@@ -49,6 +50,7 @@ WORKLOADS = (
     "game",
     "recorded",
     "env",
+    "vector",
 )
 #: the counts callgrind prints at exit (``==pid== NAME: count``), by our name
 COUNTS = {
@@ -101,6 +103,19 @@ def workload(name: str, map_name: str):
                     break
 
         return episode
+    if name == "vector":  # the batched env's tick and observations, on one thread
+        from pegame.envs.vector import vector_env
+
+        overrides = (f"env={map_name}", "evader.model=action")
+        batched = vector_env(128, overrides=overrides, opponent="random")
+        steps = np.random.default_rng(0).uniform(-1.0, 1.0, (30, 128, 2)).astype(np.float32)
+
+        def batched_steps() -> None:
+            batched.reset(seed=0)
+            for step in steps:
+                batched.step(step)
+
+        return batched_steps
     raise ValueError(f"unknown workload {name!r}; allowed: {', '.join(WORKLOADS)}")
 
 

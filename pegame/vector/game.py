@@ -177,6 +177,8 @@ class BatchedGame:
         detector = _detector(scenario)
         self._misses = misses_by_range_or_occlusion(detector)
         self._noisy = _noisy(detector)
+        #: whether a detector pair takes random numbers (drawn ahead at a reset)
+        self._draws_ahead = self._misses or self._noisy or _errs(detector)
         context = scenario.context
         self.context = context
         self.ticks_per_action = settings.ticks_per_action(context.control_dt)
@@ -240,8 +242,9 @@ class BatchedGame:
                 opponent.reset(game, streams, first)
             if self.estimation is not None:
                 self.estimation.reset(game, streams)
-            for q, seeded in enumerate(_detector_streams(seed, streams, n_p, n_e)):
-                self._draw_ahead(game * pairs + q, np.random.default_rng(seeded))
+            if self._draws_ahead:
+                for q, seeded in enumerate(_detector_streams(seed, streams, n_p, n_e)):
+                    self._draw_ahead(game * pairs + q, np.random.default_rng(seeded))
         rows = {k: (games[:, None] * k + np.arange(k)).ravel() for k in (n_p, n_e, pairs)}
         state.velocities[games] = 0.0
         state.commands[games] = 0.0
