@@ -87,6 +87,26 @@ def camera_numbers(camera: Camera, config: OracleDetector.Config) -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
+def body_box(
+    camera: np.ndarray, bearing: float, distance: float, depth: float, radius: float
+) -> tuple[float, float, float, float]:
+    """The pinhole box (x, y, w, h) (px) of the evader's body (``radius`` m, the camera
+    numbers' body height) at ``bearing`` rad, ``distance`` m and ``depth`` m, seen by the
+    camera of ``camera`` (:func:`camera_numbers`)."""
+    return pinhole(
+        camera[IMAGE_WIDTH],
+        camera[IMAGE_HEIGHT],
+        camera[FOCAL],
+        bearing,
+        distance,
+        depth,
+        radius,
+        camera[BODY_HEIGHT],
+        camera[CAMERA_HEIGHT],
+    )
+
+
+@njit(cache=True, inline="always")
 def image(
     camera: np.ndarray,
     cx: float,
@@ -110,17 +130,7 @@ def image(
     depth = distance * math.cos(bearing) + depth_error
     depth = depth if depth > camera[NEAR] else camera[NEAR]
     width, focal = camera[IMAGE_WIDTH], camera[FOCAL]
-    left, top, box_w, box_h = pinhole(
-        width,
-        camera[IMAGE_HEIGHT],
-        focal,
-        bearing,
-        distance,
-        depth,
-        radius,
-        camera[BODY_HEIGHT],
-        camera[CAMERA_HEIGHT],
-    )
+    left, top, box_w, box_h = body_box(camera, bearing, distance, depth, radius)
     seen_bearing = math.atan2(0.5 * width - (left + 0.5 * box_w), focal)
     seen_range = depth / math.cos(seen_bearing)
     heading = ctheta + seen_bearing

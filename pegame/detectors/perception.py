@@ -223,6 +223,19 @@ def detection_range(config: PerceptionConfig, camera: Camera) -> float:
     return camera.far if config.detection_range is None else config.detection_range
 
 
+@njit(cache=True)
+def burst_next(chain: int, draw: float, fraction: float, length: float, dt: float) -> bool:
+    """The Gilbert-Elliott chain's next state (True: in a burst, the frame missed) after
+    ``dt`` s from ``chain`` (-1 not yet drawn, 0 between bursts, 1 in one) on the uniform
+    ``draw``, for bursts of mean ``length`` s and the long-run missed ``fraction``: the
+    stationary law at the first frame, else the exit and entry chances over dt."""
+    if chain < 0:
+        return draw < fraction
+    if chain == 1:
+        return draw >= min(1.0, dt / length)
+    return draw < min(1.0, dt * fraction / (length * (1 - fraction)))
+
+
 @njit(cache=True, inline="always")
 def pinhole(
     width: float,
@@ -532,12 +545,8 @@ class Perception:
         if f == 0:
             return False
         draw = self.rngs["burst"].random()
-        if self._bursting is None:
-            self._bursting = draw < f  # the stationary law
-        elif self._bursting:
-            self._bursting = draw >= min(1.0, dt / length)
-        else:
-            self._bursting = draw < min(1.0, dt * f / (length * (1 - f)))
+        chain = -1 if self._bursting is None else int(self._bursting)
+        self._bursting = bool(burst_next(chain, draw, f, length, dt))
         return self._bursting
 
     def _false_positive(self, dt: float, pose: Pose, camera_height: float) -> Detection | None:

@@ -32,19 +32,18 @@ import math
 import numpy as np
 from numba import njit
 
-from pegame.detectors.oracle import image
+from pegame.detectors.oracle import body_box, image
 from pegame.detectors.perception import (
+    burst_next,
     deliver_frame,
     frame_due,
     miss_chance,
-    pinhole,
     silhouette_hidden,
 )
 from pegame.numerics import hypot
 from pegame.vector.state import (
     BEARING_DRAW,
     BEARING_NOISE,
-    BODY_HEIGHT,
     BOX_H,
     BOX_W,
     BOX_X,
@@ -52,17 +51,13 @@ from pegame.vector.state import (
     BURST_DRAW,
     BURST_FRACTION,
     BURST_LENGTH,
-    CAMERA_HEIGHT,
     DEPTH,
     DEPTH_DRAW,
     DETECTION_RANGE,
     FALSE_POSITIVE_DRAW,
     FALSE_POSITIVE_RATE,
     FAR,
-    FOCAL,
     FOV,
-    IMAGE_HEIGHT,
-    IMAGE_WIDTH,
     LATENCY,
     MISS_AT_RANGE,
     MISS_DRAW,
@@ -168,19 +163,14 @@ def detect(
 
 @njit(cache=True, inline="always")
 def burst_step(perception: np.ndarray, state: BatchState, pair: int, dt: float) -> bool:
-    """The perception model's Gilbert-Elliott chain (``Perception._burst_step``) of
-    detector pair row ``pair`` over ``dt`` s, on its next 'burst' draw; True when this
-    frame is missed."""
-    f, length = perception[BURST_FRACTION], perception[BURST_LENGTH]
+    """The perception model's Gilbert-Elliott chain (:func:`pegame.detectors.perception.
+    burst_next`, which ``Perception._burst_step`` steps too) of detector pair row ``pair``
+    over ``dt`` s, on its next 'burst' draw; True when this frame is missed."""
     k = state.noise_drawn[pair, 2]
     state.noise_drawn[pair, 2] += 1
     draw = state.noise[pair, k, BURST_DRAW]
-    if state.bursting[pair] < 0:
-        bursting = draw < f  # the stationary law
-    elif state.bursting[pair] == 1:
-        bursting = draw >= min(1.0, dt / length)
-    else:
-        bursting = draw < min(1.0, dt * f / (length * (1 - f)))
+    fraction, length = perception[BURST_FRACTION], perception[BURST_LENGTH]
+    bursting = burst_next(state.bursting[pair], draw, fraction, length, dt)
     state.bursting[pair] = 1 if bursting else 0
     return bursting
 
@@ -216,17 +206,7 @@ def false_positive(
     bearing = -0.5 * fov + (0.5 * fov - -0.5 * fov) * u1  # numpy's uniform(low, high)
     distance = math.sqrt(near**2 + (reach**2 - near**2) * u2)
     depth = max(near, distance * math.cos(bearing))
-    x, y, w, h = pinhole(
-        camera[IMAGE_WIDTH],
-        camera[IMAGE_HEIGHT],
-        camera[FOCAL],
-        bearing,
-        distance,
-        depth,
-        radius,
-        camera[BODY_HEIGHT],
-        camera[CAMERA_HEIGHT],
-    )
+    x, y, w, h = body_box(camera, bearing, distance, depth, radius)
     heading = ptheta + bearing
     out, q = state.capture, pair
     out[q, BOX_X], out[q, BOX_Y], out[q, BOX_W], out[q, BOX_H], out[q, DEPTH] = x, y, w, h, depth

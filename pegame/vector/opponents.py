@@ -181,7 +181,7 @@ def opponent_for(
     settings = scenario.settings
     decisions = -(-settings.ticks // settings.decide_every)
     index = EVADER if role == "evader" else PURSUER
-    if cls in (RandomEvader, RandomPursuer) and config.model == "action":
+    if _plays_a_table(cls, config):
         return ActionTable(index, bodies[index], num_games, decisions)
     if cls is SmartEvader and batchable(config):
         return SmartEvaderOpponent(config, scenario.context, num_games)
@@ -198,4 +198,10 @@ def needs_estimation(scenario: Scenario, learner: str) -> bool:
     if learner != "evader":
         return False
     cls, config = scenario.classes["pursuer"], scenario.configs["pursuer"]
-    return not (cls is RandomPursuer and config.model == "action")
+    return not _plays_a_table(cls, config)
+
+
+def _plays_a_table(cls: type, config: Any) -> bool:
+    """Whether the strategy ``cls`` with ``config`` is the random agent with
+    ``model=action``, which the kernels play from an action table."""
+    return cls in (RandomEvader, RandomPursuer) and config.model == "action"
